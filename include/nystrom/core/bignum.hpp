@@ -1,0 +1,99 @@
+// High-precision reference numbers for method coefficients.
+//
+// The catalog builds every coefficient in MPFR (through Boost.Multiprecision) at a precision a
+// little above the working precision, and only then converts to the working scalar type:
+// rational coefficients are therefore correctly rounded, closed forms (Forest-Ruth, Suzuki)
+// are evaluated in the working precision, and decimal tables carry exactly their published digits.
+#pragma once
+
+#include <algorithm>
+#include <complex>
+#include <stdexcept>
+#include <string>
+
+#include <boost/multiprecision/mpfr.hpp>
+
+#include "nystrom/core/scalar.hpp"
+
+namespace nystrom {
+
+// Expression templates off: values convert implicitly and read like ordinary arithmetic.
+using bigfloat = boost::multiprecision::number<boost::multiprecision::mpfr_float_backend<0>, boost::multiprecision::et_off>;
+
+struct bigcomplex {
+  bigfloat re{0};
+  bigfloat im{0};
+  bigcomplex() = default;
+  bigcomplex(bigfloat r) : re(std::move(r)), im(0) {}  // NOLINT: implicit on purpose (real -> complex)
+  bigcomplex(bigfloat r, bigfloat i) : re(std::move(r)), im(std::move(i)) {}
+  bool is_real() const { return im == 0; }
+  friend bool operator==(const bigcomplex& a, const bigcomplex& b) { return a.re == b.re && a.im == b.im; }
+  friend bigcomplex operator+(const bigcomplex& a, const bigcomplex& b) { return {a.re + b.re, a.im + b.im}; }
+  friend bigcomplex operator-(const bigcomplex& a, const bigcomplex& b) { return {a.re - b.re, a.im - b.im}; }
+  friend bigcomplex operator*(const bigcomplex& a, const bigcomplex& b) {
+    return {a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re};
+  }
+  bigcomplex& operator+=(const bigcomplex& b) {
+    re += b.re;
+    im += b.im;
+    return *this;
+  }
+  bigcomplex conj() const { return {re, -im}; }
+};
+
+/// Bits of the reference precision used to build coefficients for a working type of `bits`.
+inline unsigned reference_bits(long working_bits) { return static_cast<unsigned>(std::max<long>(256, working_bits + 64)); }
+
+/// Sets the MPFR default precision (in bits; a process-wide setting in Boost 1.74) for the lifetime of the guard.
+class BigPrecision {
+ public:
+  explicit BigPrecision(unsigned bits) : saved_(bigfloat::default_precision()) {
+    bigfloat::default_precision(bits_to_digits10(bits));
+  }
+  ~BigPrecision() { bigfloat::default_precision(saved_); }
+  BigPrecision(const BigPrecision&) = delete;
+  BigPrecision& operator=(const BigPrecision&) = delete;
+  static unsigned bits_to_digits10(unsigned bits) { return bits * 30103u / 100000u + 2u; }
+
+ private:
+  unsigned saved_;
+};
+
+/// Parses an exact rational "p/q", an integer, or a decimal "0.123e-4" at the current precision.
+inline bigfloat big(const std::string& text) {
+  const auto slash = text.find('/');
+  try {
+    if (slash != std::string::npos) {
+      bigfloat p(text.substr(0, slash));
+      bigfloat q(text.substr(slash + 1));
+      if (q == 0) throw std::invalid_argument("zero denominator");
+      return p / q;
+    }
+    return bigfloat(text);
+  } catch (const std::exception&) {
+    throw std::invalid_argument("malformed number '" + text + "'");
+  }
+}
+
+inline bigcomplex bigc(const std::string& re, const std::string& im = "0") { return {big(re), big(im)}; }
+
+/// Converts a reference value to a real working type (correct rounding where MPFR provides it).
+template <class T>
+T to_real(const bigfloat& x) {
+  return scalar_traits<T>::from_mpfr(x.backend().data());
+}
+
+/// Converts a reference complex value to a working scalar S (real or std::complex).
+/// Throws if S is real but the value has an imaginary part.
+template <class S>
+S to_scalar(const bigcomplex& x) {
+  if constexpr (is_complex_v<S>) {
+    using T = real_t<S>;
+    return S(to_real<T>(x.re), to_real<T>(x.im));
+  } else {
+    if (!(x.im == 0)) throw std::invalid_argument("complex coefficient used with a real scalar type");
+    return to_real<S>(x.re);
+  }
+}
+
+}  // namespace nystrom

@@ -1,0 +1,98 @@
+// Scalar types: real and complex, double through arbitrary precision.
+//
+// Every engine is a template on its scalar type. This header defines the small set of
+// customisation points the engines and the catalog need:
+//   * real_t<S>            the real type underlying S (S itself, or T for std::complex<T>)
+//   * is_complex_v<S>
+//   * scalar_traits<T>     name, mantissa bits, conversion from an MPFR reference value
+//   * real_part(x)         projection used by complex-coefficient methods
+// double and long double are defined here; extended types (float128, dd_real, qd_real,
+// mpfr_float) add their specialisations in nystrom/core/precision.hpp.
+#pragma once
+
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <string>
+#include <type_traits>
+
+#include <mpfr.h>
+
+namespace nystrom {
+
+template <class S>
+struct is_complex : std::false_type {};
+template <class T>
+struct is_complex<std::complex<T>> : std::true_type {};
+template <class S>
+inline constexpr bool is_complex_v = is_complex<S>::value;
+
+template <class S>
+struct real_of {
+  using type = S;
+};
+template <class T>
+struct real_of<std::complex<T>> {
+  using type = T;
+};
+template <class S>
+using real_t = typename real_of<S>::type;
+
+/// Traits of a real scalar type. Specialise for every supported precision.
+template <class T>
+struct scalar_traits;
+
+template <>
+struct scalar_traits<double> {
+  static std::string name() { return "double"; }
+  static long bits() { return std::numeric_limits<double>::digits; }
+  static double from_mpfr(mpfr_srcptr x) { return mpfr_get_d(x, MPFR_RNDN); }
+};
+
+template <>
+struct scalar_traits<long double> {
+  static std::string name() { return "long-double"; }
+  static long bits() { return std::numeric_limits<long double>::digits; }
+  static long double from_mpfr(mpfr_srcptr x) { return mpfr_get_ld(x, MPFR_RNDN); }
+};
+
+/// Machine epsilon of a real scalar type, 2^(1-bits).
+template <class T>
+T epsilon_of() {
+  return static_cast<T>(std::ldexp(1.0L, static_cast<int>(1 - scalar_traits<T>::bits())));
+}
+
+/// Conversion to double for reporting (types without an explicit conversion overload this).
+template <class T>
+double as_double(const T& x) {
+  return static_cast<double>(x);
+}
+
+template <class S>
+S real_part(const S& x) {
+  return x;
+}
+template <class T>
+std::complex<T> real_part(const std::complex<T>& x) {
+  return std::complex<T>(x.real(), T(0));
+}
+
+/// |x| for real or complex scalars, as a real.
+template <class S>
+real_t<S> magnitude(const S& x) {
+  using std::abs;
+  return abs(x);
+}
+
+/// True when a real or complex value is finite.
+template <class S>
+bool is_finite_scalar(const S& x) {
+  if constexpr (is_complex_v<S>) {
+    return is_finite_scalar(x.real()) && is_finite_scalar(x.imag());
+  } else {
+    using std::isfinite;
+    return isfinite(x);
+  }
+}
+
+}  // namespace nystrom

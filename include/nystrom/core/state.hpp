@@ -1,0 +1,125 @@
+// Phase-space state of q'' = a(q) and the few vector operations the engines use.
+//
+// A state is a pair of containers (positions q, velocities v). Any container with size(),
+// operator[] and value_type works: std::array<S, N> for small fixed systems (the compiler
+// unrolls everything), std::vector<S> for N-body. The algebra is deliberately tiny, in the
+// spirit of Boost.Odeint's separation of stepper and algebra.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "nystrom/core/scalar.hpp"
+
+namespace nystrom {
+
+/// Options shared by all engines.
+struct EngineOptions {
+  /// Complex-coefficient methods: keep the complexified state instead of dropping the
+  /// imaginary parts after every step (the default drops them, as in the Gürkan paper).
+  bool keep_complex = false;
+};
+
+template <class V>
+struct State {
+  using vector_type = V;
+  using value_type = typename V::value_type;
+  V q;
+  V v;
+};
+
+template <class V>
+struct is_std_array : std::false_type {};
+template <class S, std::size_t N>
+struct is_std_array<std::array<S, N>> : std::true_type {};
+
+/// Make `a` the same size as `b` (no-op for fixed-size containers).
+template <class V>
+void resize_like(V& a, const V& b) {
+  if constexpr (!is_std_array<V>::value) {
+    if (a.size() != b.size()) a.resize(b.size());
+  }
+}
+
+/// y += c * x, elementwise.
+template <class V, class C>
+inline void axpy(V& y, const C& c, const V& x) {
+  const std::size_t n = y.size();
+  for (std::size_t i = 0; i < n; ++i) y[i] += c * x[i];
+}
+
+/// y = x, elementwise (keeps y's storage).
+template <class V>
+inline void assign(V& y, const V& x) {
+  if constexpr (is_std_array<V>::value) {
+    y = x;
+  } else {
+    y.assign(x.begin(), x.end());
+  }
+}
+
+/// Replace every element by its real part (complex-coefficient methods).
+template <class V>
+inline void project_real(V& x) {
+  for (auto& e : x) e = real_part(e);
+}
+
+template <class V>
+bool all_finite(const V& x) {
+  for (const auto& e : x)
+    if (!is_finite_scalar(e)) return false;
+  return true;
+}
+
+/// Throws std::invalid_argument unless the state is non-empty, consistent and finite.
+template <class V>
+void validate_state(const State<V>& s) {
+  if (s.q.size() == 0) throw std::invalid_argument("empty system: the state has no coordinates");
+  if (s.q.size() != s.v.size())
+    throw std::invalid_argument("inconsistent state: " + std::to_string(s.q.size()) + " positions but " +
+                                std::to_string(s.v.size()) + " velocities");
+  if (!all_finite(s.q) || !all_finite(s.v)) throw std::invalid_argument("state contains NaN or infinite values");
+}
+
+/// Converts a real state to its complex counterpart (or copies if the types agree).
+template <class VOut, class VIn>
+State<VOut> convert_state(const State<VIn>& s) {
+  State<VOut> out;
+  if constexpr (!is_std_array<VOut>::value) {
+    out.q.resize(s.q.size());
+    out.v.resize(s.v.size());
+  }
+  using SOut = typename VOut::value_type;
+  for (std::size_t i = 0; i < s.q.size(); ++i) {
+    if constexpr (is_complex_v<SOut> && !is_complex_v<typename VIn::value_type>) {
+      out.q[i] = SOut(s.q[i], 0);
+      out.v[i] = SOut(s.v[i], 0);
+    } else if constexpr (!is_complex_v<SOut> && is_complex_v<typename VIn::value_type>) {
+      out.q[i] = s.q[i].real();
+      out.v[i] = s.v[i].real();
+    } else {
+      out.q[i] = static_cast<SOut>(s.q[i]);
+      out.v[i] = static_cast<SOut>(s.v[i]);
+    }
+  }
+  return out;
+}
+
+/// Rebinds a container type to another element type: array<S,N> -> array<U,N>, vector<S> -> vector<U>.
+template <class V, class U>
+struct rebind_vector;
+template <class S, std::size_t N, class U>
+struct rebind_vector<std::array<S, N>, U> {
+  using type = std::array<U, N>;
+};
+template <class S, class A, class U>
+struct rebind_vector<std::vector<S, A>, U> {
+  using type = std::vector<U>;
+};
+template <class V, class U>
+using rebind_vector_t = typename rebind_vector<V, U>::type;
+
+}  // namespace nystrom

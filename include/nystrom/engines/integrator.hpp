@@ -1,0 +1,91 @@
+// A uniform interface over the three engines: build any catalog method for a state type V and a
+// force functor F, then step or integrate. The engine is chosen once, at construction; the hot
+// loop runs inside the engine with the force inlined (dispatch is per integrate() call).
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <variant>
+
+#include "nystrom/core/bignum.hpp"
+#include "nystrom/engines/mpe.hpp"
+#include "nystrom/engines/rkn.hpp"
+#include "nystrom/engines/splitting.hpp"
+#include "nystrom/methods/method.hpp"
+
+namespace nystrom {
+
+/// MPE coefficients c_i converted to S. Refuses orders whose rounding amplification sum|c_i| would
+/// destroy more than half of the significant digits of S (amp * eps > sqrt(eps)): such an order is
+/// "beyond what the scalar type can represent" (double: up to M56; float128: far beyond M100).
+template <class S>
+std::vector<S> mpe_coefficients_as(const MpeCoefficients& mc) {
+  using T = real_t<S>;
+  const double amp = mpe_amplification(mc);
+  const double eps = std::ldexp(1.0, static_cast<int>(1 - scalar_traits<T>::bits()));
+  if (!(amp * eps < std::sqrt(eps)))
+    throw std::invalid_argument("MPE order " + std::to_string(mc.order()) + " is beyond what " + scalar_traits<T>::name() +
+                                " can represent: the coefficients amplify rounding by " + std::to_string(amp) +
+                                " (use a wider --precision)");
+  std::vector<S> c;
+  mpfr_t x;
+  mpfr_init2(x, static_cast<mpfr_prec_t>(reference_bits(scalar_traits<T>::bits())));
+  for (const auto& q : mc.c) {
+    mpfr_set_q(x, q.get_mpq_t(), MPFR_RNDN);
+    c.push_back(S(scalar_traits<T>::from_mpfr(x)));
+  }
+  mpfr_clear(x);
+  return c;
+}
+
+template <class V, class F>
+class Integrator {
+ public:
+  using scalar_type = typename V::value_type;
+  using real_type = real_t<scalar_type>;
+
+  Integrator(const MethodData& data, F force, EngineOptions opt = {}) : impl_(make(data, std::move(force), opt)) {}
+
+  void integrate(State<V>& s, real_type h, long n) {
+    std::visit([&](auto& e) { e.integrate(s, h, n); }, impl_);
+  }
+  void step(State<V>& s, real_type h) { integrate(s, h, 1); }
+  long force_evals() const {
+    return std::visit([](const auto& e) { return e.force_evals(); }, impl_);
+  }
+  F& force() {
+    return std::visit([](auto& e) -> F& { return e.force(); }, impl_);
+  }
+
+ private:
+  using Impl = std::variant<SplittingStepper<V, F>, RknStepper<V, F>, MpeStepper<V, F>>;
+
+  static Impl make(const MethodData& data, F force, EngineOptions opt) {
+    using S = scalar_type;
+    auto conv = [](const bigcomplex& x) { return to_scalar<S>(x); };
+    if (const auto* sp = std::get_if<SplittingScheme<bigcomplex>>(&data))
+      return Impl(std::in_place_index<0>, convert_scheme<S>(*sp, conv), std::move(force), opt);
+    if (const auto* t = std::get_if<RknTableau<bigcomplex>>(&data))
+      return Impl(std::in_place_index<1>, convert_tableau<S>(*t, conv), std::move(force), opt);
+    const auto& m = std::get<MpeDef>(data);
+    const auto mc = mpe_coefficients(m.k);
+    return Impl(std::in_place_index<2>, m.k, mpe_coefficients_as<S>(mc), convert_scheme<S>(m.base, conv),
+                std::move(force), opt);
+  }
+
+  Impl impl_;
+};
+
+/// Builds `def` for state type V at a reference precision matched to V's scalar type.
+template <class V, class F>
+Integrator<V, F> make_integrator(const MethodDef& def, F force, EngineOptions opt = {}) {
+  using T = real_t<typename V::value_type>;
+  BigPrecision guard(reference_bits(scalar_traits<T>::bits()));
+  const MethodData data = def.build();
+  return Integrator<V, F>(data, std::move(force), opt);
+}
+
+}  // namespace nystrom

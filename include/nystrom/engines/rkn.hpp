@@ -1,0 +1,184 @@
+// The explicit Runge-Kutta-Nyström engine, form (2.1) of the Gürkan paper:
+//
+//   y_i     = q_n + c_i h v_n + h^2 sum_{j<i} a_ij f(y_j)
+//   q_{n+1} = q_n + h v_n + h^2 sum_i b_i f(y_i)
+//   v_{n+1} = v_n + h sum_i B_i f(y_i)
+//
+// Any explicit RKN tableau runs here, including the force-consolidated methods of the Chin
+// paper (Nyström 4, M4, the 5-force M6, Albrecht A6, A'), which are tableaux too.
+// First-same-as-last is detected from the tableau (stage 1 at q_n, last stage at q_{n+1})
+// and the reused force is checked against the position it was evaluated at.
+// An optional embedded solution (bhat, Bhat) gives an error estimate for step control.
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nystrom/core/state.hpp"
+
+namespace nystrom {
+
+template <class C>
+struct RknTableau {
+  std::vector<C> c;
+  std::vector<std::vector<C>> a;  // s x s, strictly lower triangular
+  std::vector<C> b;               // position weights
+  std::vector<C> B;               // velocity weights
+  std::vector<C> bhat, Bhat;      // optional embedded pair (empty if none)
+
+  std::size_t stages() const { return c.size(); }
+
+  void validate() const {
+    const std::size_t s = c.size();
+    if (s == 0) throw std::invalid_argument("RKN tableau has no stages");
+    if (a.size() != s || b.size() != s || B.size() != s)
+      throw std::invalid_argument("RKN tableau: inconsistent sizes");
+    for (std::size_t i = 0; i < s; ++i) {
+      if (a[i].size() != s) throw std::invalid_argument("RKN tableau: a is not square");
+      for (std::size_t j = i; j < s; ++j)
+        if (!(a[i][j] == C(0))) throw std::invalid_argument("RKN tableau is not explicit (a_ij != 0 for j >= i)");
+    }
+    if (!bhat.empty() && (bhat.size() != s || Bhat.size() != s))
+      throw std::invalid_argument("RKN tableau: embedded weights have the wrong size");
+  }
+
+  /// Stage 1 evaluates at q_n and the last stage at q_{n+1}: the last force is the next first.
+  bool fsal() const {
+    const std::size_t s = c.size();
+    if (s < 2 || !(c[0] == C(0)) || !(c[s - 1] == C(1))) return false;
+    for (std::size_t j = 0; j < s; ++j)
+      if (!(a[s - 1][j] == b[j])) return false;
+    return true;
+  }
+  int forces_per_step() const { return static_cast<int>(stages()) - (fsal() ? 1 : 0); }
+};
+
+template <class COut, class CIn, class Conv>
+RknTableau<COut> convert_tableau(const RknTableau<CIn>& in, Conv conv) {
+  auto cv = [&](const std::vector<CIn>& x) {
+    std::vector<COut> y;
+    y.reserve(x.size());
+    for (const auto& e : x) y.push_back(conv(e));
+    return y;
+  };
+  RknTableau<COut> out;
+  out.c = cv(in.c);
+  for (const auto& row : in.a) out.a.push_back(cv(row));
+  out.b = cv(in.b);
+  out.B = cv(in.B);
+  out.bhat = cv(in.bhat);
+  out.Bhat = cv(in.Bhat);
+  return out;
+}
+
+template <class V, class Force>
+class RknStepper {
+ public:
+  using vector_type = V;
+  using scalar_type = typename V::value_type;
+  using real_type = real_t<scalar_type>;
+
+  RknStepper(RknTableau<scalar_type> t, Force force, EngineOptions opt = {})
+      : t_(std::move(t)), force_(std::move(force)), opt_(opt) {
+    t_.validate();
+    fsal_ = t_.fsal();
+    const std::size_t s = t_.stages();
+    for (std::size_t i = 0; i < s; ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (!(t_.a[i][j] == scalar_type(0))) nz_.push_back({i, j, t_.a[i][j]});
+    f_.resize(s);
+  }
+
+  const RknTableau<scalar_type>& tableau() const { return t_; }
+  long force_evals() const { return evals_; }
+  Force& force() { return force_; }
+  void reset_cache() { cache_valid_ = false; }
+
+  void step(State<V>& s, real_type h) { integrate(s, h, 1); }
+
+  void integrate(State<V>& s, real_type h, long n) {
+    for (long k = 0; k < n; ++k) one_step(s, h, nullptr);
+  }
+
+  /// One step that also returns the embedded error estimate (q, v) in err (if the tableau has one).
+  void step_with_error(State<V>& s, real_type h, State<V>& err) { one_step(s, h, &err); }
+
+ private:
+  struct Nz {
+    std::size_t i, j;
+    scalar_type a;
+  };
+
+  void one_step(State<V>& st, real_type hr, State<V>* err) {
+    const std::size_t s = t_.stages();
+    const scalar_type h(hr), h2 = h * h;
+    for (auto& f : f_) resize_like(f, st.q);
+    resize_like(y_, st.q);
+    const bool project = is_complex_v<scalar_type> && !opt_.keep_complex;
+    std::size_t k = 0;  // index into nz_, ordered by stage
+    for (std::size_t i = 0; i < s; ++i) {
+      if (i == 0 && fsal_ && cache_valid_ && same(aq_, st.q)) {
+        while (k < nz_.size() && nz_[k].i == 0) ++k;
+        continue;  // f_[0] already holds the force at q_n
+      }
+      assign(y_, st.q);
+      if (!(t_.c[i] == scalar_type(0))) axpy(y_, t_.c[i] * h, st.v);
+      for (; k < nz_.size() && nz_[k].i == i; ++k) axpy(y_, nz_[k].a * h2, f_[nz_[k].j]);
+      force_(y_, f_[i]);
+      ++evals_;
+    }
+    if (err) {
+      resize_like(err->q, st.q);
+      resize_like(err->v, st.q);
+      for (auto& e : err->q) e = scalar_type(0);
+      for (auto& e : err->v) e = scalar_type(0);
+      if (!t_.bhat.empty())
+        for (std::size_t i = 0; i < s; ++i) {
+          axpy(err->q, (t_.b[i] - t_.bhat[i]) * h2, f_[i]);
+          axpy(err->v, (t_.B[i] - t_.Bhat[i]) * h, f_[i]);
+        }
+    }
+    axpy(st.q, h, st.v);
+    for (std::size_t i = 0; i < s; ++i)
+      if (!(t_.b[i] == scalar_type(0))) axpy(st.q, t_.b[i] * h2, f_[i]);
+    for (std::size_t i = 0; i < s; ++i)
+      if (!(t_.B[i] == scalar_type(0))) axpy(st.v, t_.B[i] * h, f_[i]);
+    if (project) {
+      project_real(st.q);
+      project_real(st.v);
+    }
+    if (fsal_ && !project) {
+      // The last stage was evaluated at q_{n+1} up to rounding; reuse it exactly as the
+      // method prescribes (the tableau says y_s = q_{n+1}).
+      std::swap(f_[0], f_[s - 1]);
+      resize_like(aq_, st.q);
+      assign(aq_, st.q);
+      cache_valid_ = true;
+    } else {
+      cache_valid_ = false;
+    }
+  }
+
+  static bool same(const V& x, const V& y) {
+    if (x.size() != y.size()) return false;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (!(x[i] == y[i])) return false;
+    return true;
+  }
+
+  RknTableau<scalar_type> t_;
+  Force force_;
+  EngineOptions opt_;
+  bool fsal_ = false;
+  std::vector<Nz> nz_;
+  std::vector<V> f_;
+  V y_{};
+  V aq_{};
+  bool cache_valid_ = false;
+  long evals_ = 0;
+};
+
+}  // namespace nystrom

@@ -1,0 +1,80 @@
+// One measured run on the Kepler problem: the numbers `nystrom run` prints and `nystrom sweep` plots.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <stdexcept>
+#include <string>
+
+#include "nystrom/engines/integrator.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/kepler.hpp"
+
+namespace nystrom {
+
+struct KeplerRunResult {
+  std::string method;
+  int order = 0;
+  std::string precision;
+  double ecc = 0;
+  long steps = 0;
+  long force_evals = 0;
+  double h = 0;
+  double precession_per_period = 0;  // signed LRL rotation per period (rad), counter-clockwise positive
+  double energy_error = 0;           // relative |E - E0| / |E0| at the end
+  double position_error = 0;         // |q - q_exact| at the end
+  double seconds = 0;
+};
+
+/// Integrates `periods` orbits with `steps_per_period` steps each, in real type T.
+template <class T>
+KeplerRunResult run_kepler(const MethodDef& def, double ecc, long steps_per_period, long periods,
+                           EngineOptions opt = {}) {
+  if (steps_per_period <= 0) throw std::invalid_argument("steps per period must be positive");
+  if (periods <= 0) throw std::invalid_argument("number of periods must be positive");
+  if (!std::isfinite(ecc)) throw std::invalid_argument("eccentricity is not finite");
+  const KeplerProblem<T> prob(static_cast<T>(ecc));
+  const long n = steps_per_period * periods;
+  const T h = KeplerProblem<T>::period() / T(steps_per_period);
+  const auto s0 = prob.initial_state();
+  State<std::array<T, 2>> s;
+  long evals = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (def.info.complex) {
+    using C = std::complex<T>;
+    auto integ = make_integrator<std::array<C, 2>>(def, KeplerForce{}, opt);
+    auto sc = convert_state<std::array<C, 2>>(s0);
+    integ.integrate(sc, h, n);
+    s = convert_state<std::array<T, 2>>(sc);
+    evals = integ.force_evals();
+  } else {
+    auto integ = make_integrator<std::array<T, 2>>(def, KeplerForce{}, opt);
+    s = s0;
+    integ.integrate(s, h, n);
+    evals = integ.force_evals();
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  KeplerRunResult r;
+  r.method = def.info.name;
+  r.order = def.info.order;
+  r.precision = scalar_traits<T>::name();
+  r.ecc = ecc;
+  r.steps = n;
+  r.force_evals = evals;
+  r.h = as_double(h);
+  r.seconds = std::chrono::duration<double>(t1 - t0).count();
+  using std::abs;
+  using std::sqrt;
+  const T angle = signed_angle(lrl_vector(s0), lrl_vector(s));
+  r.precession_per_period = as_double(angle / T(periods));
+  const T e0 = kepler_energy(s0);
+  r.energy_error = as_double(abs((kepler_energy(s) - e0) / e0));
+  const auto ex = prob.exact(h * T(n));
+  const T dx = s.q[0] - ex.q[0], dy = s.q[1] - ex.q[1];
+  r.position_error = as_double(sqrt(dx * dx + dy * dy));
+  return r;
+}
+
+}  // namespace nystrom

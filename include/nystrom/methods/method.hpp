@@ -1,0 +1,102 @@
+// What a method in the catalog is: its descriptive record (MethodInfo) and its coefficients as
+// data (MethodData), built in high precision on demand.
+#pragma once
+
+#include <functional>
+#include <initializer_list>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "nystrom/core/bignum.hpp"
+#include "nystrom/engines/mpe.hpp"
+#include "nystrom/engines/rkn.hpp"
+#include "nystrom/engines/splitting.hpp"
+
+namespace nystrom {
+
+struct MethodInfo {
+  std::string name;
+  std::string family;  // "splitting", "composition", "rkn", "mpe"
+  int order = 0;
+  int stages = 0;           // force stages of one step (kicks, RKN stages, or T_2 applications)
+  int forces_per_step = 0;  // force evaluations per step in a long run (FSAL accounted)
+  bool fsal = false;
+  bool symmetric = false;
+  bool symplectic = false;
+  bool complex = false;
+  bool adaptive = false;      // embedded pair with step-size control
+  int published_digits = 0;   // 0: exact (rational or closed form); else digits of the published table
+  std::string source;         // the publication the coefficients come from
+  std::string description;
+  std::vector<std::string> aliases;
+};
+
+/// A multi-product method: the sequence {k_i} and the symmetric second-order base T_2.
+struct MpeDef {
+  std::vector<long> k;
+  std::string base_name;
+  SplittingScheme<bigcomplex> base;
+};
+
+using MethodData = std::variant<SplittingScheme<bigcomplex>, RknTableau<bigcomplex>, MpeDef>;
+
+struct MethodDef {
+  MethodInfo info;
+  /// Builds the coefficients at the current reference precision (see BigPrecision).
+  std::function<MethodData()> build;
+};
+
+// ---- helpers for writing tables ---------------------------------------------------------------
+
+inline SubStep<bigcomplex> drift(bigcomplex c) { return {Flow::drift, std::move(c)}; }
+inline SubStep<bigcomplex> kick(bigcomplex c) { return {Flow::kick, std::move(c)}; }
+
+inline SplittingScheme<bigcomplex> scheme(std::initializer_list<SubStep<bigcomplex>> steps) {
+  SplittingScheme<bigcomplex> s;
+  s.steps.assign(steps.begin(), steps.end());
+  return s;
+}
+
+/// Velocity Verlet, eq (25): kick h/2, drift h, kick h/2.
+inline SplittingScheme<bigcomplex> velocity_verlet_scheme() {
+  return scheme({kick(big("1/2")), drift(big("1")), kick(big("1/2"))});
+}
+/// Position Verlet, eq (26): drift h/2, kick h, drift h/2.
+inline SplittingScheme<bigcomplex> position_verlet_scheme() {
+  return scheme({drift(big("1/2")), kick(big("1")), drift(big("1/2"))});
+}
+
+/// Composition prod_i S(w_i h) of a symmetric base S (weights in order of application); adjacent
+/// half-steps of the base merge.
+inline SplittingScheme<bigcomplex> compose(const SplittingScheme<bigcomplex>& base, const std::vector<bigcomplex>& w) {
+  SplittingScheme<bigcomplex> out;
+  for (const auto& wi : w)
+    for (const auto& s : base.steps) out.steps.push_back({s.flow, s.coef * wi});
+  return normalized(out);
+}
+
+/// Symmetric weights from the first half: w_1..w_m given, full sequence w_1..w_m..w_1 (odd length
+/// if `middle` is true: the last given weight is the central one).
+inline std::vector<bigcomplex> palindrome(const std::vector<bigcomplex>& half, bool middle) {
+  std::vector<bigcomplex> w = half;
+  for (std::size_t i = half.size() - (middle ? 1 : 0); i-- > 0;) w.push_back(half[i]);
+  return w;
+}
+
+/// RKN tableau from rows written as strings (exact rationals or decimals).
+inline RknTableau<bigcomplex> tableau(const std::vector<std::string>& c, const std::vector<std::vector<std::string>>& a,
+                                      const std::vector<std::string>& b, const std::vector<std::string>& B) {
+  RknTableau<bigcomplex> t;
+  const std::size_t s = c.size();
+  for (const auto& x : c) t.c.push_back(big(x));
+  t.a.assign(s, std::vector<bigcomplex>(s, bigcomplex(big("0"))));
+  for (std::size_t i = 0; i < a.size() && i < s; ++i)
+    for (std::size_t j = 0; j < a[i].size() && j < s; ++j) t.a[i][j] = big(a[i][j]);
+  for (const auto& x : b) t.b.push_back(big(x));
+  for (const auto& x : B) t.B.push_back(big(x));
+  return t;
+}
+
+}  // namespace nystrom

@@ -1,0 +1,140 @@
+// The planar Kepler problem of Chin (2010), eqs (35)-(36), and its analytic solution.
+//
+//   a = -q / |q|^3,  q0 = (1+e, 0),  v0 = (0, sqrt((1-e)/(1+e))),  E = -1/2,  period 2 pi.
+//
+// The start is the apocentre on the +x axis and the motion is counter-clockwise; the pericentre
+// lies on the -x axis, so the Laplace-Runge-Lenz vector is (-e, 0). The mean anomaly at time t is
+// pi + t, and Kepler's equation M = E - e sin E is solved by Newton's method in the working type.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "nystrom/core/state.hpp"
+
+namespace nystrom {
+
+/// Force functor: works for any real or complex scalar (complex square root for complex q).
+struct KeplerForce {
+  template <class S>
+  void operator()(const std::array<S, 2>& q, std::array<S, 2>& a) const {
+    using std::sqrt;
+    const S r2 = q[0] * q[0] + q[1] * q[1];
+    const S r = sqrt(r2);
+    const S minv = S(-1) / (r2 * r);
+    a[0] = minv * q[0];
+    a[1] = minv * q[1];
+  }
+};
+
+/// Kepler's equation M = E - e sin E, solved for E by Newton's method (starting at E = M + e sin M,
+/// or pi for e > 0.8, which converges for all M and e < 1).
+template <class T>
+T eccentric_anomaly(const T& M, const T& e) {
+  using std::abs;
+  using std::acos;
+  using std::floor;
+  using std::cos;
+  using std::sin;
+  const T pi = acos(T(-1));
+  // Reduce M to [-pi, pi].
+  T m = M - T(2) * pi * floor((M + pi) / (T(2) * pi));
+  T E = e > T(0.8) ? (m >= T(0) ? pi : -pi) : m + e * sin(m);
+  for (int it = 0; it < 200; ++it) {
+    const T f = E - e * sin(E) - m;
+    const T d = f / (T(1) - e * cos(E));
+    E -= d;
+    if (abs(d) <= T(4) * epsilon_of<T>() * (T(1) + abs(E))) break;
+  }
+  return E + (M - m);
+}
+
+/// The Kepler problem at eccentricity e in scalar type T.
+template <class T>
+struct KeplerProblem {
+  using vector_type = std::array<T, 2>;
+  T e;
+
+  explicit KeplerProblem(T ecc) : e(ecc) {
+    if (!(ecc >= T(0)) || !(ecc < T(1))) throw std::invalid_argument("eccentricity must satisfy 0 <= e < 1");
+  }
+
+  KeplerForce force() const { return {}; }
+  static T period() {
+    using std::acos;
+    return T(2) * acos(T(-1));
+  }
+  static T exact_energy() { return T(-1) / T(2); }
+
+  State<vector_type> initial_state() const {
+    using std::sqrt;
+    return {{T(1) + e, T(0)}, {T(0), sqrt((T(1) - e) / (T(1) + e))}};
+  }
+
+  /// The analytic solution at time t.
+  State<vector_type> exact(const T& t) const {
+    using std::acos;
+    using std::cos;
+    using std::sin;
+    using std::sqrt;
+    const T pi = acos(T(-1));
+    const T E = eccentric_anomaly<T>(pi + t, e);
+    const T s = sqrt(T(1) - e * e);
+    const T cE = cos(E), sE = sin(E);
+    const T Edot = T(1) / (T(1) - e * cE);
+    return {{e - cE, -s * sE}, {sE * Edot, -s * cE * Edot}};
+  }
+};
+
+/// Energy |v|^2/2 - 1/|q|.
+template <class T>
+T kepler_energy(const State<std::array<T, 2>>& s) {
+  using std::sqrt;
+  return (s.v[0] * s.v[0] + s.v[1] * s.v[1]) / T(2) - T(1) / sqrt(s.q[0] * s.q[0] + s.q[1] * s.q[1]);
+}
+
+/// The Laplace-Runge-Lenz vector A = v x L - q/|q|, eq (37), in the plane.
+template <class T>
+std::array<T, 2> lrl_vector(const State<std::array<T, 2>>& s) {
+  using std::sqrt;
+  const T L = s.q[0] * s.v[1] - s.q[1] * s.v[0];
+  const T r = sqrt(s.q[0] * s.q[0] + s.q[1] * s.q[1]);
+  return {s.v[1] * L - s.q[0] / r, -s.v[0] * L - s.q[1] / r};
+}
+
+/// Signed angle from vector a to vector b, counter-clockwise positive, in (-pi, pi].
+template <class T>
+T signed_angle(const std::array<T, 2>& a, const std::array<T, 2>& b) {
+  using std::atan2;
+  return atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1]);
+}
+
+/// The harmonic oscillator q'' = -omega^2 q in d dimensions, with its exact solution.
+struct HarmonicForce {
+  double omega2 = 1.0;
+  template <class V>
+  void operator()(const V& q, V& a) const {
+    using S = typename V::value_type;
+    for (std::size_t i = 0; i < q.size(); ++i) a[i] = -S(omega2) * q[i];
+  }
+};
+
+template <class T>
+struct HarmonicProblem {
+  using vector_type = std::array<T, 1>;
+  HarmonicForce force() const { return {}; }
+  State<vector_type> initial_state() const { return {{T(1)}, {T(0)}}; }
+  State<vector_type> exact(const T& t) const {
+    using std::cos;
+    using std::sin;
+    return {{cos(t)}, {-sin(t)}};
+  }
+  static T period() {
+    using std::acos;
+    return T(2) * acos(T(-1));
+  }
+};
+
+}  // namespace nystrom
