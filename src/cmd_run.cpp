@@ -1,0 +1,49 @@
+// `nystrom run --problem kepler --ecc 0.9 --method M8 --steps-per-period 1000 --periods 10 [--json]`
+#include <iostream>
+#include <memory>
+
+#include <fmt/core.h>
+
+#include "cli.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "runner.hpp"
+
+namespace {
+
+struct Options {
+  nystrom::cli::RunRequest req;
+  std::string method;
+  bool json = false;
+};
+
+nystrom::cli::Registrar reg("run", "Integrate one problem with one method and report its errors", [](CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  app.add_option("--problem", o->req.problem, "Problem: kepler (Chin eqs 35-36) or harmonic")->capture_default_str();
+  app.add_option("--ecc", o->req.ecc, "Kepler eccentricity, 0 <= e < 1")->capture_default_str();
+  app.add_option("--method", o->method, "Method name or spec (see `nystrom methods`)")->required();
+  app.add_option("--steps-per-period", o->req.steps_per_period, "Steps per orbital period")->capture_default_str();
+  app.add_option("--periods", o->req.periods, "Number of whole periods")->capture_default_str();
+  app.add_option("--precision", o->req.precision, "Scalar type (double, long-double, ...)")->capture_default_str();
+  app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
+  app.add_flag("--json", o->json, "Print one JSON object");
+  return [o]() {
+    const auto def = nystrom::resolve_method(o->method);
+    const auto r = nystrom::cli::run_case(o->req, def);
+    if (o->json) {
+      std::cout << r.to_json().dump(2) << "\n";
+      return 0;
+    }
+    fmt::print("method            {} ({}, order {})\n", r.method, r.family, r.order);
+    fmt::print("problem           {}{}\n", r.problem, r.problem == "kepler" ? fmt::format(" e = {}", r.ecc) : "");
+    fmt::print("precision         {}\n", r.precision);
+    fmt::print("steps             {} (h = {:.6g})\n", r.steps, r.h);
+    fmt::print("force evaluations {}\n", r.force_evals);
+    if (r.problem == "kepler") fmt::print("precession/period {:+.6e} rad\n", r.precession_per_period);
+    fmt::print("energy error      {:.6e} (relative)\n", r.energy_error);
+    fmt::print("position error    {:.6e}\n", r.position_error);
+    fmt::print("time              {:.6f} s\n", r.seconds);
+    return 0;
+  };
+});
+
+}  // namespace

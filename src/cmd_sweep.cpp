@@ -1,0 +1,69 @@
+// `nystrom sweep --problem kepler --ecc 0.9 --methods FR,N4,M4,M6,A6 --force-evals 1e3:1e6:20
+//                [--csv FILE] [--plot FILE.png]`: precision against effort, as in Chin's Figs 2-3.
+//
+// N is the number of force evaluations spent on one orbital period: a method with f forces per step
+// runs round(N / f) steps per period (h = 2 pi f / N). The error is the LRL precession per period.
+#include <iostream>
+#include <memory>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+#include "sweep.hpp"
+
+namespace {
+
+struct Options {
+  nystrom::cli::RunRequest base;
+  std::string methods = "FR,N4,M4,M6,A6";
+  std::string evals = "1e3:1e6:20";
+  std::string csv, plot, metric = "precession";
+  bool json = false;
+};
+
+nystrom::cli::Registrar reg("sweep", "Error against force evaluations for several methods (precision-effort)",
+                            [](CLI::App& app) {
+                              auto o = std::make_shared<Options>();
+                              o->base.periods = 1;
+                              app.add_option("--problem", o->base.problem, "Problem (kepler, harmonic)")->capture_default_str();
+                              app.add_option("--ecc", o->base.ecc, "Kepler eccentricity")->capture_default_str();
+                              app.add_option("--methods", o->methods, "Comma-separated methods")->capture_default_str();
+                              app.add_option("--force-evals", o->evals, "FROM:TO:COUNT force evaluations per period (log-spaced)")
+                                  ->capture_default_str();
+                              app.add_option("--periods", o->base.periods, "Periods integrated per run")->capture_default_str();
+                              app.add_option("--precision", o->base.precision, "Scalar type")->capture_default_str();
+                              app.add_option("--error", o->metric, "Error measure: precession, position, energy")
+                                  ->capture_default_str();
+                              app.add_option("--csv", o->csv, "Write the data as CSV");
+                              app.add_option("--plot", o->plot, "Draw a log-log PNG plot (gnuplot)");
+                              app.add_flag("--json", o->json, "Print JSON rows instead of a table");
+                              return [o]() {
+                                using namespace nystrom::cli;
+                                SweepRequest req;
+                                req.base = o->base;
+                                req.methods = split_list(o->methods, "--methods");
+                                req.force_evals = parse_log_range(o->evals, "--force-evals");
+                                sweep_error(SweepRow{}, o->metric);  // validate the measure before running
+                                const auto rows = run_sweep(req);
+                                if (!o->csv.empty()) write_file_atomic(o->csv, sweep_csv(rows));
+                                if (!o->plot.empty())
+                                  sweep_plot(rows, o->metric,
+                                             fmt::format("{} e = {} ({})", req.base.problem, req.base.ecc, req.base.precision),
+                                             o->plot);
+                                if (o->json) {
+                                  nlohmann::json arr = nlohmann::json::array();
+                                  for (const auto& r : rows) {
+                                    auto j = r.report.to_json();
+                                    j["force_evals_per_period"] = r.force_evals_per_period;
+                                    arr.push_back(j);
+                                  }
+                                  std::cout << arr.dump(2) << "\n";
+                                } else {
+                                  sweep_table(rows, o->metric);
+                                }
+                                return 0;
+                              };
+                            });
+
+}  // namespace

@@ -1,0 +1,90 @@
+#include "sweep.hpp"
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include <fmt/core.h>
+
+#include "cli.hpp"
+#include "nystrom/methods/catalog.hpp"
+
+namespace nystrom::cli {
+
+std::vector<SweepRow> run_sweep(const SweepRequest& req) {
+  if (req.methods.empty()) throw UsageError("no methods given");
+  if (req.force_evals.empty()) throw UsageError("no force-evaluation counts given");
+  std::vector<MethodDef> defs;
+  for (const auto& m : req.methods) defs.push_back(resolve_method(m));  // fail early on unknown names
+  std::vector<SweepRow> rows;
+  Progress progress("sweep", static_cast<long>(defs.size() * req.force_evals.size()));
+  long done = 0;
+  for (const auto& def : defs) {
+    const int f = std::max(1, def.info.forces_per_step);
+    long last_steps = -1;
+    for (double N : req.force_evals) {
+      RunRequest r = req.base;
+      r.steps_per_period = std::max(1L, std::lround(N / f));
+      progress.tick(++done);
+      if (r.steps_per_period == last_steps) continue;  // same run as the previous N
+      last_steps = r.steps_per_period;
+      SweepRow row;
+      row.report = run_case(r, def);
+      row.force_evals_per_period = static_cast<double>(row.report.force_evals) / static_cast<double>(r.periods);
+      rows.push_back(row);
+    }
+  }
+  return rows;
+}
+
+double sweep_error(const SweepRow& row, const std::string& metric) {
+  if (metric == "precession") return std::abs(row.report.precession_per_period);
+  if (metric == "position") return row.report.position_error;
+  if (metric == "energy") return row.report.energy_error;
+  throw UsageError("unknown error measure '" + metric + "' (precession, position, energy)");
+}
+
+std::string sweep_csv(const std::vector<SweepRow>& rows) {
+  std::ostringstream out;
+  out << "method,family,order,precision,problem,ecc,force_evals_per_period,steps,force_evals,h,"
+         "precession_per_period,energy_error,position_error,seconds\n";
+  out.precision(17);
+  for (const auto& r : rows) {
+    const auto& p = r.report;
+    out << p.method << "," << p.family << "," << p.order << "," << p.precision << "," << p.problem << "," << p.ecc << ","
+        << r.force_evals_per_period << "," << p.steps << "," << p.force_evals << "," << p.h << ","
+        << p.precession_per_period << "," << p.energy_error << "," << p.position_error << "," << p.seconds << "\n";
+  }
+  return out.str();
+}
+
+void sweep_plot(const std::vector<SweepRow>& rows, const std::string& metric, const std::string& title,
+                const std::string& png) {
+  std::vector<Series> series;
+  std::map<std::string, std::size_t> index;
+  for (const auto& r : rows) {
+    auto it = index.find(r.report.method);
+    if (it == index.end()) {
+      it = index.emplace(r.report.method, series.size()).first;
+      series.push_back({r.report.method, {}, {}});
+    }
+    series[it->second].x.push_back(r.force_evals_per_period);
+    series[it->second].y.push_back(sweep_error(r, metric));
+  }
+  const std::string ylabel = metric == "precession" ? "|precession| per period (rad)"
+                             : metric == "position" ? "position error at the end"
+                                                    : "relative energy error at the end";
+  plot_loglog(png, title, "force evaluations per period N", ylabel, series);
+}
+
+void sweep_table(const std::vector<SweepRow>& rows, const std::string& metric) {
+  fmt::print("{:<12} {:>5} {:>12} {:>10} {:>14} {:>12} {:>12} {:>9}\n", "method", "order", "N/period", "steps",
+             metric == "precession" ? "|dtheta|/per" : metric, "energy err", "pos err", "seconds");
+  for (const auto& r : rows) {
+    const auto& p = r.report;
+    fmt::print("{:<12} {:>5} {:>12.0f} {:>10} {:>14.3e} {:>12.3e} {:>12.3e} {:>9.4f}\n", p.method, p.order,
+               r.force_evals_per_period, p.steps, sweep_error(r, metric), p.energy_error, p.position_error, p.seconds);
+  }
+}
+
+}  // namespace nystrom::cli

@@ -1,0 +1,33 @@
+// Precision against effort: error against force evaluations per period, for several methods.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "runner.hpp"
+
+namespace nystrom::cli {
+
+struct SweepRow {
+  double force_evals_per_period = 0;  // the N of Chin's Figs 2 and 3
+  RunReport report;
+};
+
+struct SweepRequest {
+  RunRequest base;                     // problem, ecc, periods, precision
+  std::vector<std::string> methods;
+  std::vector<double> force_evals;     // target force evaluations per period
+};
+
+/// Runs every (method, N); N is turned into steps per period as round(N / forces_per_step).
+std::vector<SweepRow> run_sweep(const SweepRequest& req);
+
+/// The error plotted and tabulated: "precession" (|dtheta| per period), "position" or "energy".
+double sweep_error(const SweepRow& row, const std::string& metric);
+
+std::string sweep_csv(const std::vector<SweepRow>& rows);
+void sweep_plot(const std::vector<SweepRow>& rows, const std::string& metric, const std::string& title,
+                const std::string& png);
+void sweep_table(const std::vector<SweepRow>& rows, const std::string& metric);
+
+}  // namespace nystrom::cli
