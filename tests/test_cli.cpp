@@ -1,0 +1,178 @@
+// The command-line contract: `methods`, `coeffs`, `run`, `sweep`, `demo`, and bad input (exit code 2,
+// one clear line on stderr, no crash). The tool is found through NYSTROM_BIN (set by CTest).
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string tool() {
+  const char* b = std::getenv("NYSTROM_BIN");
+  return b ? b : "nystrom";
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::filesystem::path temp_dir() {
+  auto d = std::filesystem::temp_directory_path() /
+           ("nystrom-cli-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+Result run(const std::string& args) {
+  const auto dir = temp_dir();
+  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = tool() + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+}  // namespace
+
+TEST(Cli, MethodsJsonListsTheCatalog) {
+  const auto r = run("methods --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.is_array());
+  std::set<std::string> names;
+  for (const auto& m : j) {
+    for (const char* key : {"name", "family", "order", "force_evals_per_step", "symmetric", "symplectic", "complex",
+                            "source", "fsal", "stages"})
+      EXPECT_TRUE(m.contains(key)) << key;
+    EXPECT_GT(m["order"].get<int>(), 0);
+    EXPECT_GT(m["force_evals_per_step"].get<int>(), 0);
+    EXPECT_FALSE(m["source"].get<std::string>().empty());
+    names.insert(m["name"]);
+  }
+  for (const char* n : {"VV", "PV", "FR", "N4", "M4", "M6", "M6-5F", "A6", "Aprime", "M8", "M16"})
+    EXPECT_TRUE(names.count(n)) << n;
+}
+
+TEST(Cli, CoeffsMpeAreExactFractions) {
+  const auto r = run("coeffs mpe --seq 1,2,3 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["coefficients"], nlohmann::json({"1/24", "-16/15", "81/40"}));
+  EXPECT_EQ(j["error_coefficient"], "1/36");
+  EXPECT_EQ(j["order"], 6);
+  const auto opt = nlohmann::json::parse(run("coeffs mpe --n 3 --sum 12 --json").out);
+  EXPECT_EQ(opt["sequence"], nlohmann::json({3, 4, 5}));
+}
+
+TEST(Cli, RunJsonHasTheContractFields) {
+  const auto r = run("run --problem kepler --ecc 0.9 --method M8 --steps-per-period 1000 --periods 10 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key :
+       {"method", "order", "steps", "force_evals", "precession_per_period", "energy_error", "position_error", "seconds"})
+    ASSERT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["method"], "M8");
+  EXPECT_EQ(j["order"], 8);
+  EXPECT_EQ(j["steps"], 10000);
+  EXPECT_EQ(j["force_evals"], 100000);
+  // Eighth order at h = 2 pi / 1000 on e = 0.9: the orbit is followed to ~1e-8 over ten periods.
+  EXPECT_LT(std::abs(j["precession_per_period"].get<double>()), 1e-9);
+  EXPECT_LT(j["position_error"].get<double>(), 1e-6);
+  EXPECT_LT(j["energy_error"].get<double>(), 1e-7);
+}
+
+TEST(Cli, RunReproducesChinFig1ErrorCoefficientsAtE09) {
+  // e_P = dtheta / h^4 at e = 0.9 (Chin, Fig. 1 and text): FR -23.1e4, N 7.1e4, M4 -1.1e4, A' -1.4e4.
+  const double h = 2 * M_PI / 5000;
+  auto eP = [&](const std::string& m) {
+    const auto j = nlohmann::json::parse(
+        run("run --ecc 0.9 --method " + m + " --steps-per-period 5000 --periods 1 --precision long-double --json").out);
+    return j["precession_per_period"].get<double>() / std::pow(h, 4);
+  };
+  EXPECT_NEAR(eP("FR"), -23.1e4, 0.06e4);
+  EXPECT_NEAR(eP("N4"), 7.1e4, 0.06e4);
+  EXPECT_NEAR(eP("M4"), -1.1e4, 0.06e4);
+  EXPECT_NEAR(eP("Aprime"), -1.4e4, 0.06e4);
+}
+
+TEST(Cli, SweepWritesCsvAndPlot) {
+  const auto dir = temp_dir();
+  const auto csv = dir / "s.csv", png = dir / "s.png";
+  const auto r = run("sweep --problem kepler --ecc 0.5 --methods FR,M4 --force-evals 1e3:1e4:3 --csv " + csv.string() +
+                     " --plot " + png.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = slurp(csv);
+  EXPECT_EQ(text.rfind("method,", 0), 0u);
+  int lines = 0;
+  for (char c : text) lines += c == '\n';
+  EXPECT_EQ(lines, 1 + 2 * 3);
+  const std::string pngdata = slurp(png);
+  ASSERT_GT(pngdata.size(), 8u);
+  EXPECT_EQ(pngdata.substr(1, 3), "PNG");
+  // No temporary files are left behind by the atomic writes.
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+TEST(Cli, DemoWritesItsFiles) {
+  const auto dir = temp_dir();
+  const auto r = run("demo --out-dir " + dir.string() + " --methods FR,M4,M8 --force-evals 3e3:3e4:3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("M8"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "demo.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "demo.png"));
+}
+
+TEST(Cli, BadInputIsOneClearLineAndExitCode2) {
+  const char* cases[] = {
+      "",                                                        // no subcommand
+      "frobnicate",                                              // unknown subcommand
+      "run --method NOPE",                                       // unknown method
+      "run --method M4 --problem sun",                           // unknown problem
+      "run --method M4 --ecc 1",                                 // e >= 1
+      "run --method M4 --ecc -0.1",                              // e < 0
+      "run --method M4 --ecc nan",                               // NaN
+      "run --method M4 --steps-per-period 0",                    // non-positive steps
+      "run --method M4 --steps-per-period -5",                   //
+      "run --method M4 --periods 0",                             //
+      "run --method M4 --precision float7",                      // unknown precision
+      "run --method mpe:1,1",                                    // duplicate MPE member
+      "run --method mpe:0,1",                                    // zero member
+      "run --method mpe:1,,2",                                   // malformed sequence
+      "run --method M7",                                         // odd order
+      "run --method M80",                                        // order beyond double
+      "coeffs mpe --seq 1,2,x",                                  //
+      "coeffs mpe",                                              // nothing asked
+      "sweep --methods FR --force-evals 1e3:1e2:5",              // decreasing range
+      "sweep --methods FR --force-evals 1e3:1e4",                // malformed range
+      "sweep --methods FR,,M4",                                  // empty item
+      "sweep --methods FR --force-evals 1e3:1e4:3 --error foo",  // unknown measure
+      "sweep --methods FR --force-evals 1e3:1e4:3 --csv /nonexistent/dir/x.csv",
+  };
+  for (const char* args : cases) {
+    const auto r = run(args);
+    EXPECT_EQ(r.code, 2) << "args: " << args << "\nstderr: " << r.err;
+    EXPECT_NE(r.err.find("error"), std::string::npos) << "args: " << args;
+    EXPECT_LE(std::count(r.err.begin(), r.err.end(), '\n'), 2) << "args: " << args << "\n" << r.err;
+  }
+}
