@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "nystrom/methods/chin2010.hpp"
+#include "nystrom/methods/dormand_prince1987.hpp"
 #include "nystrom/methods/method.hpp"
 
 namespace nystrom {
@@ -73,6 +74,7 @@ inline const std::vector<MethodDef>& catalog() {
     };
     add(methods::chin2010());
     add(methods::chin2010_mpe());
+    add(methods::dormand_prince1987());
     for (auto& d : v) detail::finalize_info(d);
     return v;
   }();

@@ -1,0 +1,137 @@
+// The Dormand-El-Mikkawy-Prince RKN12(10) pair (methods/dormand_prince1987.hpp): the order conditions
+// prove the transcribed rationals (order exactly 12 for b/B, exactly 10 for bhat/Bhat), the catalog
+// entries, and the fixed-step convergence rates on Kepler.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "nystrom/analysis/rkn_order_conditions.hpp"
+#include "nystrom/engines/integrator.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/methods/dormand_prince1987.hpp"
+#include "nystrom/problems/kepler.hpp"
+
+using namespace nystrom;
+
+namespace {
+
+RknTableau<bigfloat> real_tableau(const RknTableau<bigcomplex>& t) {
+  return convert_tableau<bigfloat>(t, [](const bigcomplex& x) { return x.re; });
+}
+
+}  // namespace
+
+TEST(DormandPrince1987, TwelfthOrderWeightsHaveOrderExactlyTwelve) {
+  BigPrecision guard(256);
+  RknOrderConditions<bigfloat> oc(real_tableau(methods::dprkn12_tableau()));
+  // Rounding would be ~1e-75 here; the published rows 14-17 are consistent to ~1e-53 (see below).
+  EXPECT_LE(oc.max_residual(12), bigfloat("1e-50"));
+  EXPECT_GT(oc.max_residual_of_order(13), bigfloat("1e-9"));
+  // Both weight vectors fail at order 13: b (trees with rho = 12) and B (rho = 13).
+  bigfloat wb = 0, wB = 0;
+  for (const auto& r : oc.residuals(13)) {
+    bigfloat& w = r.info.weight == RknWeight::position ? wb : wB;
+    w = std::max(w, bigfloat(abs(r.residual)));
+  }
+  EXPECT_GT(wb, bigfloat("1e-9"));
+  EXPECT_GT(wB, bigfloat("1e-9"));
+}
+
+TEST(DormandPrince1987, TenthOrderWeightsHaveOrderExactlyTen) {
+  BigPrecision guard(256);
+  for (const auto& t : {real_tableau(methods::dprkn10_tableau()),
+                        real_tableau(embedded_tableau(methods::dprkn12_10_tableau()))}) {
+    RknOrderConditions<bigfloat> oc(t);
+    EXPECT_LE(oc.max_residual(10), bigfloat("1e-50"));
+    EXPECT_GT(oc.max_residual_of_order(11), bigfloat("1e-8"));
+  }
+  // The 17th stage carries no 10th-order weight: DP10 drops it and loses nothing.
+  const auto pair = methods::dprkn12_10_tableau();
+  EXPECT_TRUE(pair.bhat[16] == bigcomplex(bigfloat(0)));
+  EXPECT_TRUE(pair.Bhat[16] == bigcomplex(bigfloat(0)));
+}
+
+TEST(DormandPrince1987, OrdersInLongDouble) {
+  BigPrecision guard(256);
+  auto ld = [](const RknTableau<bigcomplex>& t) {
+    return convert_tableau<long double>(t, [](const bigcomplex& x) { return to_real<long double>(x.re); });
+  };
+  EXPECT_EQ(rkn_order(ld(methods::dprkn12_tableau()), 1e-15L), 12);
+  EXPECT_EQ(rkn_order(ld(methods::dprkn10_tableau()), 1e-15L), 10);
+  EXPECT_LE(max_residual(ld(methods::dprkn12_tableau()), 12), 1e-16L);
+}
+
+// The rows of a satisfy sum_j a_ij = c_i^2 / 2 (the pair is built for y'' = f(x, y)). Rows 1-13 as
+// published do so exactly; rows 14-17 only to ~1e-53: their published fractions are partly not in
+// lowest terms and behave like rational approximations of the exact values (the row-14 defect is
+// exactly 5 / denominator of a_14,6, i.e. the last digit of its numerator). This pins the digits
+// down: an edit anywhere in the table shows here or in the order conditions above.
+TEST(DormandPrince1987, RowSumsAndTheirPublishedAccuracy) {
+  BigPrecision guard(256);
+  const auto t = real_tableau(methods::dprkn12_tableau());
+  for (std::size_t i = 0; i < 17; ++i) {
+    bigfloat s = 0;
+    for (std::size_t j = 0; j < i; ++j) s += t.a[i][j];
+    const bigfloat d = abs(s - t.c[i] * t.c[i] / 2);
+    if (i < 13) {
+      EXPECT_LE(d, bigfloat("1e-70")) << "row " << i + 1;
+    } else {
+      EXPECT_LE(d, bigfloat("1e-52")) << "row " << i + 1;
+    }
+  }
+  bigfloat s14 = 0;
+  for (std::size_t j = 0; j < 13; ++j) s14 += t.a[13][j];
+  const bigfloat den("324512095420929759624784749347170583153994213035432256");
+  EXPECT_LE(abs((s14 - t.c[13] * t.c[13] / 2) * den - 5), bigfloat("1e-10"));
+}
+
+TEST(DormandPrince1987, CatalogEntries) {
+  const auto d12 = resolve_method("DP12");
+  const auto d10 = resolve_method("DP10");
+  const auto da = resolve_method("DP12-adaptive");
+  EXPECT_EQ(d12.info.family, "rkn");
+  EXPECT_EQ(d12.info.order, 12);
+  EXPECT_EQ(d12.info.stages, 17);
+  EXPECT_EQ(d12.info.forces_per_step, 17);
+  EXPECT_FALSE(d12.info.fsal);
+  EXPECT_FALSE(d12.info.adaptive);
+  EXPECT_EQ(d10.info.order, 10);
+  EXPECT_EQ(d10.info.stages, 16);
+  EXPECT_EQ(d10.info.forces_per_step, 16);
+  EXPECT_FALSE(d10.info.adaptive);
+  EXPECT_TRUE(da.info.adaptive);
+  EXPECT_EQ(da.info.order, 12);
+  EXPECT_EQ(da.info.forces_per_step, 17);
+  EXPECT_FALSE(da.info.fsal);
+  EXPECT_EQ(resolve_method("dprkn12").info.name, "DP12");
+  BigPrecision guard(256);
+  const auto t = methods::dprkn12_10_tableau();
+  EXPECT_NO_THROW(t.validate());
+  EXPECT_FALSE(t.fsal());  // the last stage (c = 1) is not at the 12th-order q_{n+1}
+}
+
+// Fixed-step convergence on Kepler (e = 0.5) at t = 4, not a whole period (NOTES.md).
+TEST(DormandPrince1987, FixedStepConvergenceRates) {
+  using T = long double;
+  using V = std::array<T, 2>;
+  const KeplerProblem<T> kp(0.5L);
+  const T tend = 4;
+  const auto ex = kp.exact(tend);
+  auto error = [&](const MethodDef& d, long n) {
+    auto in = make_integrator<V>(d, KeplerForce{});
+    auto s = kp.initial_state();
+    in.integrate(s, tend / T(n), n);
+    EXPECT_EQ(in.force_evals(), n * d.info.forces_per_step);
+    T e = 0;
+    for (int i = 0; i < 2; ++i) e = std::max({e, std::abs(s.q[i] - ex.q[i]), std::abs(s.v[i] - ex.v[i])});
+    return static_cast<double>(e);
+  };
+  const double p12 = std::log2(error(resolve_method("DP12"), 24) / error(resolve_method("DP12"), 48));
+  const double p10 = std::log2(error(resolve_method("DP10"), 24) / error(resolve_method("DP10"), 48));
+  EXPECT_GT(p12, 11.0);
+  EXPECT_LT(p12, 14.0);
+  EXPECT_GT(p10, 9.0);
+  EXPECT_LT(p10, 12.0);
+}
