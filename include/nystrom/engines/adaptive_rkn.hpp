@@ -1,0 +1,322 @@
+// Step-size control for an embedded RKN pair (e.g. the Dormand-El-Mikkawy-Prince RKN12(10),
+// catalog entry "DP12-adaptive").
+//
+// API (what the CLI calls for `nystrom run --method DP12-adaptive --tol 1e-12`):
+//
+//   nystrom::AdaptiveOptions opt;            // all fields optional except tol
+//   opt.tol = 1e-12;
+//   auto ai = nystrom::make_adaptive_integrator<V>(def, force, opt);   // def: a MethodDef whose
+//                                            // tableau carries bhat/Bhat (info.adaptive == true)
+//   nystrom::AdaptiveStats st = ai.integrate_to(state, t0, t1);        // lands exactly on t1
+//   nystrom::AdaptiveStats st = ai.integrate_to(state, t0, t1,
+//       [](auto t, const nystrom::State<V>& s) { ... });               // observer: t0, then every accepted step
+//   st.accepted, st.rejected, st.force_evals, st.last_h                 // this call; ai.total() sums all calls
+//
+// V is std::array<T, N> or std::vector<T> with a real T (double, long double, float128, ...).
+// Errors: std::invalid_argument for bad input (tol <= 0 or not finite or below 10 eps of the scalar
+// type, t1 < t0, t0/t1 not finite,
+// NaN/inf or inconsistent state, a tableau without embedded weights, bad options);
+// nystrom::StepSizeUnderflow (a std::runtime_error) when the step size falls below the rounding
+// level of t, which happens when the tolerance cannot be met (too strict for the scalar type) or
+// the solution is singular; nystrom::TooManySteps (std::runtime_error) after opt.max_steps steps.
+// After such an exception the state holds the last accepted step (the observer has seen its time).
+//
+// The controller (Hairer, Norsett & Wanner I, sec. II.4; Brankin et al., ACM TOMS 15 (1989) 31):
+//   * error estimate: the difference of the two solutions of the pair, in q (h^2 sum (b - bhat) f)
+//     and v (h sum (B - Bhat) f); the higher-order solution is propagated (local extrapolation);
+//   * norm: err = sqrt( (1/2n) sum_i (e_i / sc_i)^2 ) over all n positions and n velocities, with
+//     sc_i = tol * (1 + max(|y_i(t)|, |y_i(t+h)|)): mixed absolute/relative with one tolerance;
+//   * accept when err <= 1; new h = h * min(fac_max, max(fac_min, safety * err^(-1/(p+1)))), p the
+//     lower order of the pair; after a rejection the step may not grow in the next attempt;
+//   * first step: Hairer's starting-step algorithm (two force evaluations) unless opt.h0 > 0; later
+//     calls continue with the step proposed at the end of the previous call;
+//   * the last step is shortened to land exactly on t1 (and a step within 1% of the end is stretched).
+// Force evaluations are counted exactly, rejected steps and the starting-step estimate included.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstddef>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <variant>
+
+#include "nystrom/analysis/rkn_order_conditions.hpp"
+#include "nystrom/core/bignum.hpp"
+#include "nystrom/core/state.hpp"
+#include "nystrom/engines/rkn.hpp"
+#include "nystrom/methods/method.hpp"
+
+namespace nystrom {
+
+class StepSizeUnderflow : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+class TooManySteps : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct AdaptiveOptions {
+  double tol = 1e-10;      // absolute and relative tolerance (see the norm above)
+  double safety = 0.7;     // safety factor on the optimal step (see below)
+  double fac_min = 0.2;    // smallest step ratio per step
+  double fac_max = 4.0;    // largest step ratio per step
+  double h0 = 0.0;         // first step; 0: automatic
+  double h_max = 0.0;      // largest step; 0: |t1 - t0|
+  long max_steps = 10000000;  // accepted + rejected steps per integrate_to call
+  int error_order = 0;     // p, the lower order of the pair; 0: determined from the tableau
+
+  void validate() const {
+    if (!std::isfinite(tol) || !(tol > 0)) throw std::invalid_argument("tolerance must be a positive finite number");
+    if (!(safety > 0 && safety <= 1)) throw std::invalid_argument("safety factor must be in (0, 1]");
+    if (!(fac_min > 0 && fac_min < 1)) throw std::invalid_argument("fac_min must be in (0, 1)");
+    if (!(fac_max > 1 && std::isfinite(fac_max))) throw std::invalid_argument("fac_max must be a finite number > 1");
+    if (!std::isfinite(h0) || h0 < 0) throw std::invalid_argument("initial step h0 must be finite and >= 0");
+    if (!std::isfinite(h_max) || h_max < 0) throw std::invalid_argument("h_max must be finite and >= 0");
+    if (max_steps <= 0) throw std::invalid_argument("max_steps must be positive");
+    if (error_order < 0) throw std::invalid_argument("error_order must be >= 0");
+  }
+};
+
+struct AdaptiveStats {
+  long accepted = 0;
+  long rejected = 0;
+  long force_evals = 0;
+  double last_h = 0;  // the last accepted step
+  AdaptiveStats& operator+=(const AdaptiveStats& o) {
+    accepted += o.accepted;
+    rejected += o.rejected;
+    force_evals += o.force_evals;
+    if (o.accepted > 0) last_h = o.last_h;
+    return *this;
+  }
+};
+
+/// The order of the embedded weights of a tableau, from its order conditions (long double
+/// residuals; a condition counts as satisfied below 1e-12).
+template <class S>
+int embedded_order(const RknTableau<S>& t, int max_order = 14) {
+  auto ld = convert_tableau<long double>(t, [](const S& x) { return static_cast<long double>(x); });
+  return rkn_order(embedded_tableau(ld), 1e-12L, max_order);
+}
+
+namespace adaptive_detail {
+inline std::string sci(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+struct NoObserver {
+  template <class T, class St>
+  void operator()(const T&, const St&) const {}
+};
+}  // namespace adaptive_detail
+
+template <class V, class Force>
+class AdaptiveRknIntegrator {
+  static std::string sci(double x) { return adaptive_detail::sci(x); }
+
+ public:
+  using vector_type = V;
+  using scalar_type = typename V::value_type;
+  using real_type = scalar_type;
+  static_assert(!is_complex_v<scalar_type>, "adaptive step control needs a real scalar type");
+
+  AdaptiveRknIntegrator(RknTableau<scalar_type> t, Force force, AdaptiveOptions opt = {})
+      : opt_(opt), stepper_(check(std::move(t)), std::move(force)) {
+    opt_.validate();
+    const double min_tol = 10 * static_cast<double>(std::numeric_limits<real_type>::epsilon());
+    if (opt_.tol < min_tol)
+      throw std::invalid_argument("tolerance " + sci(opt_.tol) + " is below what " + scalar_traits<real_type>::name() +
+                                  " resolves (10 eps = " + sci(min_tol) + "); use a wider precision");
+    if (opt_.error_order == 0) opt_.error_order = embedded_order(stepper_.tableau());
+    if (opt_.error_order < 1) throw std::invalid_argument("the embedded weights of the tableau have no order");
+    const int high = rkn_order(convert_tableau<long double>(stepper_.tableau(),
+                                                            [](const scalar_type& x) { return static_cast<long double>(x); }),
+                               1e-12L, 14);
+    method_order_ = high > 0 ? high : opt_.error_order;
+  }
+
+  const AdaptiveOptions& options() const { return opt_; }
+  int error_order() const { return opt_.error_order; }
+  int method_order() const { return method_order_; }
+  const AdaptiveStats& total() const { return total_; }
+  Force& force() { return stepper_.force(); }
+
+  template <class Observer = adaptive_detail::NoObserver>
+  AdaptiveStats integrate_to(State<V>& s, real_type t0, real_type t1, Observer&& obs = {}) {
+    using std::abs;
+    using std::isfinite;
+    using std::pow;
+    if (!isfinite(t0) || !isfinite(t1)) throw std::invalid_argument("integration times must be finite");
+    if (t1 < t0) throw std::invalid_argument("end time t1 must not be before the start time t0");
+    validate_state(s);
+    AdaptiveStats st;
+    const long evals_before = stepper_.force_evals();
+    obs(static_cast<const real_type&>(t0), static_cast<const State<V>&>(s));
+    if (t1 == t0) return st;
+
+    const real_type span = t1 - t0;
+    const real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
+    const real_type tol(opt_.tol);
+    const real_type eps = std::numeric_limits<real_type>::epsilon();
+    real_type h;
+    long extra_evals = 0;
+    if (opt_.h0 > 0) {
+      h = real_type(opt_.h0);
+    } else if (h_next_ > real_type(0)) {
+      h = h_next_;
+    } else {
+      h = initial_step(s, hmax, tol);
+      extra_evals = 2;
+    }
+    h = std::min(h, hmax);
+
+    const real_type expo = real_type(-1) / real_type(opt_.error_order + 1);
+    const real_type tiny = real_type(16) * eps * std::max(abs(t0), abs(t1));
+    real_type t = t0;
+    real_type h_want = h;  // the controller's proposal for the next step
+    bool last_rejected = false;
+    State<V> y = s, err;
+    while (t < t1) {
+      if (st.accepted + st.rejected >= opt_.max_steps)
+        throw TooManySteps("adaptive RKN: more than " + std::to_string(opt_.max_steps) + " steps before reaching t1");
+      h = h_want;
+      bool last = false;
+      if (t + h * real_type(1.01) >= t1) {
+        h = t1 - t;
+        last = true;
+      }
+      if (!(h > tiny) || !(h > real_type(0)))
+        throw StepSizeUnderflow("adaptive RKN: step size underflow at t = " + sci(static_cast<double>(t)) +
+                                " (h = " + sci(static_cast<double>(h)) +
+                                "): the tolerance cannot be met or the solution is singular");
+      assign_state(y, s);
+      stepper_.step_with_error(y, h, err);
+      const real_type e = error_norm(s, y, err, tol);
+      if (e <= real_type(1)) {
+        assign_state(s, y);
+        t = last ? t1 : t + h;
+        ++st.accepted;
+        st.last_h = static_cast<double>(h);
+        obs(static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
+        real_type fac = e > real_type(0) ? real_type(opt_.safety) * pow(e, expo) : real_type(opt_.fac_max);
+        fac = std::min(real_type(opt_.fac_max), std::max(real_type(opt_.fac_min), fac));
+        if (last_rejected) fac = std::min(fac, real_type(1));
+        // After a step shortened to land on t1, keep the earlier proposal for the next call.
+        h_next_ = last && h < h_want ? h_want : std::min(h * fac, hmax);
+        h_want = std::min(h * fac, hmax);
+        last_rejected = false;
+      } else {
+        ++st.rejected;
+        real_type fac = isfinite(e) ? real_type(opt_.safety) * pow(e, expo) : real_type(opt_.fac_min);
+        fac = std::min(real_type(1), std::max(real_type(opt_.fac_min), fac));
+        h_want = h * fac;
+        last_rejected = true;
+      }
+    }
+    st.force_evals = stepper_.force_evals() - evals_before + extra_evals;
+    total_ += st;
+    return st;
+  }
+
+  /// Forget the step carried over between calls (the next call estimates a first step again).
+  void reset() { h_next_ = real_type(0); }
+
+ private:
+  static RknTableau<scalar_type> check(RknTableau<scalar_type> t) {
+    t.validate();
+    if (t.bhat.empty())
+      throw std::invalid_argument("adaptive step control needs a tableau with embedded weights (bhat, Bhat)");
+    return t;
+  }
+
+  static void assign_state(State<V>& dst, const State<V>& src) {
+    resize_like(dst.q, src.q);
+    resize_like(dst.v, src.v);
+    assign(dst.q, src.q);
+    assign(dst.v, src.v);
+  }
+
+  real_type error_norm(const State<V>& y0, const State<V>& y1, const State<V>& e, const real_type& tol) const {
+    using std::abs;
+    using std::sqrt;
+    real_type sum(0);
+    const std::size_t n = y0.q.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const real_type sq = tol * (real_type(1) + std::max(abs(y0.q[i]), abs(y1.q[i])));
+      const real_type sv = tol * (real_type(1) + std::max(abs(y0.v[i]), abs(y1.v[i])));
+      const real_type rq = e.q[i] / sq, rv = e.v[i] / sv;
+      sum += rq * rq + rv * rv;
+    }
+    const real_type r = sqrt(sum / real_type(2 * n));
+    using std::isfinite;
+    return isfinite(r) ? r : std::numeric_limits<real_type>::infinity();
+  }
+
+  // Hairer's starting step for y' = F(y), y = (q, v), F = (v, a(q)); two force evaluations.
+  real_type initial_step(const State<V>& s, const real_type& hmax, const real_type& tol) {
+    using std::abs;
+    using std::max;
+    using std::pow;
+    using std::sqrt;
+    const std::size_t n = s.q.size();
+    V a0 = s.q, a1 = s.q;
+    stepper_.force()(s.q, a0);
+    auto norm2 = [&](auto&& comp) {
+      real_type sum(0);
+      for (std::size_t i = 0; i < n; ++i) {
+        const real_type sq = tol * (real_type(1) + abs(s.q[i]));
+        const real_type sv = tol * (real_type(1) + abs(s.v[i]));
+        const auto [x, y] = comp(i);
+        sum += (x / sq) * (x / sq) + (y / sv) * (y / sv);
+      }
+      return sqrt(sum / real_type(2 * n));
+    };
+    const real_type d0 = norm2([&](std::size_t i) { return std::pair<real_type, real_type>(s.q[i], s.v[i]); });
+    const real_type d1 = norm2([&](std::size_t i) { return std::pair<real_type, real_type>(s.v[i], a0[i]); });
+    real_type h0 = (d0 < real_type(1e-5) || d1 < real_type(1e-5)) ? real_type(1e-6) : real_type(0.01) * d0 / d1;
+    h0 = std::min(h0, hmax);
+    V q1 = s.q;
+    for (std::size_t i = 0; i < n; ++i) q1[i] = s.q[i] + h0 * s.v[i];
+    stepper_.force()(q1, a1);
+    const real_type d2 =
+        norm2([&](std::size_t i) { return std::pair<real_type, real_type>(h0 * a0[i], a1[i] - a0[i]); }) / h0;
+    const real_type dm = max(d1, d2);
+    const real_type h1 = dm <= real_type(1e-15) ? max(real_type(1e-6), h0 * real_type(1e-3))
+                                                : pow(real_type(0.01) / dm, real_type(1) / real_type(method_order_ + 1));
+    real_type h = std::min(real_type(100) * h0, h1);
+    h = std::min(h, hmax);
+    using std::isfinite;
+    if (!isfinite(h) || !(h > real_type(0))) h = hmax * real_type(1e-3);
+    return h;
+  }
+
+  AdaptiveOptions opt_;
+  RknStepper<V, Force> stepper_;
+  int method_order_ = 0;
+  real_type h_next_ = real_type(0);
+  AdaptiveStats total_;
+};
+
+/// Builds an adaptive integrator for a catalog method with embedded weights, at a reference
+/// precision matched to V's scalar type.
+template <class V, class F>
+AdaptiveRknIntegrator<V, F> make_adaptive_integrator(const MethodDef& def, F force, AdaptiveOptions opt = {}) {
+  using S = typename V::value_type;
+  opt.validate();
+  BigPrecision guard(reference_bits(scalar_traits<S>::bits()));
+  const MethodData data = def.build();
+  const auto* t = std::get_if<RknTableau<bigcomplex>>(&data);
+  if (!t || t->bhat.empty())
+    throw std::invalid_argument("method '" + def.info.name + "' has no embedded pair: it cannot run with a tolerance");
+  auto conv = [](const bigcomplex& x) { return to_scalar<S>(x); };
+  return AdaptiveRknIntegrator<V, F>(convert_tableau<S>(*t, conv), std::move(force), opt);
+}
+
+}  // namespace nystrom

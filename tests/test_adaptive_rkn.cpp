@@ -1,0 +1,177 @@
+// The adaptive RKN engine (engines/adaptive_rkn.hpp) with the Dormand-El-Mikkawy-Prince RKN12(10)
+// pair: the error tracks the tolerance on Kepler, the end time is hit exactly, force evaluations are
+// counted exactly, and bad input or an unattainable tolerance fails with a clear exception.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "nystrom/engines/adaptive_rkn.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/kepler.hpp"
+
+using namespace nystrom;
+
+namespace {
+
+using LD = long double;
+using V2 = std::array<LD, 2>;
+
+template <class T>
+double max_error(const State<std::array<T, 2>>& a, const State<std::array<T, 2>>& b) {
+  T e = 0;
+  for (int i = 0; i < 2; ++i) e = std::max({e, std::abs(a.q[i] - b.q[i]), std::abs(a.v[i] - b.v[i])});
+  return static_cast<double>(e);
+}
+
+struct CountingKepler {
+  long* calls;
+  template <class S>
+  void operator()(const std::array<S, 2>& q, std::array<S, 2>& a) const {
+    ++*calls;
+    KeplerForce{}(q, a);
+  }
+};
+
+// q'' = 2 q^3, q(0) = 1, v(0) = 1: q = 1 / (1 - t), singular at t = 1.
+struct BlowUp {
+  template <class V>
+  void operator()(const V& q, V& a) const {
+    for (std::size_t i = 0; i < q.size(); ++i) a[i] = 2 * q[i] * q[i] * q[i];
+  }
+};
+
+AdaptiveOptions with_tol(double tol) {
+  AdaptiveOptions o;
+  o.tol = tol;
+  return o;
+}
+
+}  // namespace
+
+// Kepler e = 0.5 over one period in long double: the error follows the tolerance (below it: the
+// 12th-order solution is propagated while the 10th-order one is controlled) and the work grows
+// slowly, like tol^(-1/11).
+TEST(AdaptiveRkn, KeplerErrorTracksTheTolerance) {
+  const KeplerProblem<LD> kp(0.5L);
+  const MethodDef def = resolve_method("DP12-adaptive");
+  std::vector<double> errs, work;
+  for (double tol : {1e-8, 1e-10, 1e-12}) {
+    auto ai = make_adaptive_integrator<V2>(def, KeplerForce{}, with_tol(tol));
+    EXPECT_EQ(ai.error_order(), 10);
+    EXPECT_EQ(ai.method_order(), 12);
+    auto s = kp.initial_state();
+    const AdaptiveStats st = ai.integrate_to(s, 0.0L, KeplerProblem<LD>::period());
+    const double e = max_error(s, kp.exact(KeplerProblem<LD>::period()));
+    EXPECT_LE(e, 10 * tol) << "tol " << tol;
+    EXPECT_GE(e, 1e-4 * tol) << "tol " << tol;
+    errs.push_back(e);
+    work.push_back(static_cast<double>(st.force_evals));
+    EXPECT_EQ(st.force_evals, 17 * (st.accepted + st.rejected) + 2);
+  }
+  EXPECT_LT(errs[1], errs[0] / 10);
+  EXPECT_LT(errs[2], errs[1] / 10);
+  EXPECT_GT(work[2], work[0]);
+  EXPECT_LT(work[2], 4 * work[0]);  // 1e4 in tolerance, (1e4)^(1/11) = 2.3 in work
+}
+
+TEST(AdaptiveRkn, LandsExactlyOnTheEndAndObservesEveryAcceptedStep) {
+  const KeplerProblem<LD> kp(0.5L);
+  auto ai = make_adaptive_integrator<V2>(resolve_method("DP12-adaptive"), KeplerForce{}, with_tol(1e-10));
+  auto s = kp.initial_state();
+  const LD t0 = 0.25L, t1 = 3.7L;
+  std::vector<LD> times;
+  const AdaptiveStats st = ai.integrate_to(s, t0, t1, [&](LD t, const State<V2>& y) {
+    times.push_back(t);
+    EXPECT_TRUE(std::isfinite(static_cast<double>(y.q[0])));
+  });
+  ASSERT_EQ(times.size(), static_cast<std::size_t>(st.accepted + 1));
+  EXPECT_EQ(times.front(), t0);
+  EXPECT_EQ(times.back(), t1);  // exactly
+  for (std::size_t i = 1; i < times.size(); ++i) EXPECT_GT(times[i], times[i - 1]);
+  EXPECT_GT(st.last_h, 0.0);
+  // Started at t0 = 0.25 from the t = 0 initial state: compare with the solution shifted in time.
+  EXPECT_LE(max_error(s, kp.exact(t1 - t0)), 1e-9);
+  // A zero-length interval does nothing.
+  auto s2 = s;
+  const AdaptiveStats none = ai.integrate_to(s2, t1, t1);
+  EXPECT_EQ(none.accepted + none.rejected + none.force_evals, 0);
+  EXPECT_EQ(s2.q, s.q);
+}
+
+TEST(AdaptiveRkn, ContinuesAcrossCallsAndCountsForcesExactly) {
+  const KeplerProblem<LD> kp(0.9L);
+  long calls = 0;
+  auto ai = make_adaptive_integrator<V2>(resolve_method("DP12-adaptive"), CountingKepler{&calls}, with_tol(1e-11));
+  auto s = kp.initial_state();
+  const LD T = KeplerProblem<LD>::period();
+  AdaptiveStats a = ai.integrate_to(s, 0.0L, T / 3);
+  AdaptiveStats b = ai.integrate_to(s, T / 3, T);
+  EXPECT_EQ(a.force_evals + b.force_evals, calls);
+  EXPECT_EQ(ai.total().force_evals, calls);
+  EXPECT_EQ(ai.total().accepted, a.accepted + b.accepted);
+  EXPECT_EQ(b.force_evals, 17 * (b.accepted + b.rejected));  // the second call reuses the last step size
+  EXPECT_LE(max_error(s, kp.exact(T)), 1e-9);
+  EXPECT_GT(a.rejected + b.rejected + a.accepted, 0);
+}
+
+TEST(AdaptiveRkn, WorksInDoubleWithVectors) {
+  using V = std::vector<double>;
+  AdaptiveOptions o = with_tol(1e-9);
+  o.h0 = 0.01;
+  auto ai = make_adaptive_integrator<V>(resolve_method("DP12-adaptive"), HarmonicForce{}, o);
+  State<V> s{{1.0}, {0.0}};
+  const AdaptiveStats st = ai.integrate_to(s, 0.0, 10.0);
+  EXPECT_NEAR(s.q[0], std::cos(10.0), 1e-8);
+  EXPECT_NEAR(s.v[0], -std::sin(10.0), 1e-8);
+  EXPECT_EQ(st.force_evals, 17 * (st.accepted + st.rejected));  // h0 given: no starting-step estimate
+}
+
+TEST(AdaptiveRkn, RejectsBadInput) {
+  const MethodDef def = resolve_method("DP12-adaptive");
+  for (double tol : {0.0, -1e-8, std::nan(""), std::numeric_limits<double>::infinity()})
+    EXPECT_THROW(make_adaptive_integrator<V2>(def, KeplerForce{}, with_tol(tol)), std::invalid_argument) << tol;
+  AdaptiveOptions bad = with_tol(1e-8);
+  bad.safety = 1.5;
+  EXPECT_THROW(make_adaptive_integrator<V2>(def, KeplerForce{}, bad), std::invalid_argument);
+  // A method without an embedded pair cannot run with a tolerance.
+  EXPECT_THROW(make_adaptive_integrator<V2>(resolve_method("DP12"), KeplerForce{}, with_tol(1e-8)),
+               std::invalid_argument);
+  EXPECT_THROW(make_adaptive_integrator<V2>(resolve_method("VV"), KeplerForce{}, with_tol(1e-8)), std::invalid_argument);
+
+  auto ai = make_adaptive_integrator<V2>(def, KeplerForce{}, with_tol(1e-8));
+  auto s = KeplerProblem<LD>(0.5L).initial_state();
+  EXPECT_THROW(ai.integrate_to(s, 1.0L, 0.5L), std::invalid_argument);  // t1 < t0
+  EXPECT_THROW(ai.integrate_to(s, 0.0L, std::numeric_limits<LD>::infinity()), std::invalid_argument);
+  auto nan_state = s;
+  nan_state.v[1] = std::numeric_limits<LD>::quiet_NaN();
+  EXPECT_THROW(ai.integrate_to(nan_state, 0.0L, 1.0L), std::invalid_argument);
+}
+
+TEST(AdaptiveRkn, SingularSolutionEndsWithAStepSizeUnderflow) {
+  using V = std::array<double, 1>;
+  auto ai = make_adaptive_integrator<V>(resolve_method("DP12-adaptive"), BlowUp{}, with_tol(1e-10));
+  State<V> s{{1.0}, {1.0}};
+  double t_last = 0;
+  EXPECT_THROW(ai.integrate_to(s, 0.0, 2.0, [&](double t, const State<V>&) { t_last = t; }), StepSizeUnderflow);
+  EXPECT_GT(t_last, 0.99);  // it got close to the singularity at t = 1 before giving up
+  EXPECT_LT(t_last, 1.0);
+}
+
+TEST(AdaptiveRkn, RejectsAToleranceBelowTheRoundingLevel) {
+  // 10 eps: about 2e-15 in double, 1e-18 in long double.
+  using VD = std::array<double, 2>;
+  EXPECT_THROW(make_adaptive_integrator<VD>(resolve_method("DP12-adaptive"), KeplerForce{}, with_tol(1e-16)),
+               std::invalid_argument);
+  EXPECT_NO_THROW(make_adaptive_integrator<V2>(resolve_method("DP12-adaptive"), KeplerForce{}, with_tol(1e-16)));
+}
+
+TEST(AdaptiveRkn, StepLimitIsAClearError) {
+  AdaptiveOptions o = with_tol(1e-12);
+  o.max_steps = 5;
+  auto ai = make_adaptive_integrator<V2>(resolve_method("DP12-adaptive"), KeplerForce{}, o);
+  auto s = KeplerProblem<LD>(0.5L).initial_state();
+  EXPECT_THROW(ai.integrate_to(s, 0.0L, 100.0L), TooManySteps);
+}
