@@ -1,0 +1,140 @@
+// The Gragg-Bulirsch-Stoer reference integrator: convergence to the analytic Kepler solution at its
+// tolerance, in double and long double, every step-size sequence, the N-body two-body problem, bad input.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "nystrom/engines/gbs.hpp"
+#include "nystrom/problems/kepler.hpp"
+#include "nystrom/problems/nbody.hpp"
+
+using namespace nystrom;
+
+namespace {
+
+template <class T>
+T kepler_error(double ecc, double tol, double t_end, GbsSequence seq = GbsSequence::harmonic, long* evals = nullptr) {
+  const KeplerProblem<T> prob{T(ecc)};
+  auto s = prob.initial_state();
+  GbsOptions o;
+  o.rtol = o.atol = tol;
+  o.sequence = seq;
+  GbsIntegrator<std::array<T, 2>, KeplerForce> g(KeplerForce{}, o);
+  g.integrate_to(s, T(t_end));
+  if (evals) *evals = g.force_evals();
+  const auto ex = prob.exact(T(t_end));
+  using std::abs;
+  using std::hypot;
+  T e = 0;
+  for (int i = 0; i < 2; ++i) e = std::max({e, abs(s.q[i] - ex.q[i]), abs(s.v[i] - ex.v[i])});
+  return e;
+}
+
+}  // namespace
+
+TEST(Gbs, ConvergesToTheKeplerSolutionAtItsTolerance) {
+  // Spans like the steps of the local-error experiment, started on the exact orbit: the error is within a
+  // few times the tolerance.
+  for (double ecc : {0.2, 0.7})
+    for (double tol : {1e-8, 1e-11, 1e-14}) {
+      const KeplerProblem<double> prob{ecc};
+      for (double t0 : {0.0, 1.0, 2.5, 4.0})
+        for (double span : {0.01, 0.1, 0.5}) {
+          auto s = prob.exact(t0);
+          GbsOptions o;
+          o.rtol = o.atol = tol;
+          GbsIntegrator<std::array<double, 2>, KeplerForce> g(KeplerForce{}, o);
+          g.integrate_to(s, span);
+          const auto ex = prob.exact(t0 + span);
+          for (int i = 0; i < 2; ++i) {
+            EXPECT_LT(std::abs(s.q[i] - ex.q[i]), 10 * tol) << ecc << " " << tol << " " << t0 << " " << span;
+            EXPECT_LT(std::abs(s.v[i] - ex.v[i]), 10 * tol) << ecc << " " << tol << " " << t0 << " " << span;
+          }
+        }
+    }
+  // Over 3.3 periods the global error (local errors carried along the orbit) falls with the tolerance.
+  const double t = 3.3 * 2 * M_PI;
+  double prev = 1;
+  for (double tol : {1e-6, 1e-9, 1e-12, 1e-14}) {
+    const double e = kepler_error<double>(0.2, tol, t);
+    EXPECT_LT(e, 1000 * tol) << "tol = " << tol;
+    EXPECT_LT(e, prev) << "tol = " << tol;
+    prev = e;
+  }
+}
+
+TEST(Gbs, ExtendedPrecisionGoesBelowDouble) {
+  const KeplerProblem<long double> prob{0.2L};
+  for (long double t0 : {0.0L, 1.0L, 2.5L}) {
+    auto s = prob.exact(t0);
+    GbsOptions o;
+    o.rtol = o.atol = 1e-17;
+    GbsIntegrator<std::array<long double, 2>, KeplerForce> g(KeplerForce{}, o);
+    g.integrate_to(s, 0.3L);
+    const auto ex = prob.exact(t0 + 0.3L);
+    for (int i = 0; i < 2; ++i) EXPECT_LT(std::abs(s.q[i] - ex.q[i]), 2e-16L);
+  }
+  EXPECT_LT(kepler_error<long double>(0.2, 1e-17, 3.3 * 2 * M_PI), 1e-14L);
+}
+
+TEST(Gbs, EverySequenceConverges) {
+  for (auto seq : {GbsSequence::harmonic, GbsSequence::romberg, GbsSequence::bulirsch}) {
+    long evals = 0;
+    EXPECT_LT(kepler_error<double>(0.2, 1e-11, 5.0, seq, &evals), 1e-9);
+    EXPECT_GT(evals, 0);
+  }
+  EXPECT_EQ(gbs_sequence(GbsSequence::harmonic, 4), (std::vector<long>{2, 4, 6, 8}));
+  EXPECT_EQ(gbs_sequence(GbsSequence::romberg, 4), (std::vector<long>{2, 4, 8, 16}));
+  EXPECT_EQ(gbs_sequence(GbsSequence::bulirsch, 7), (std::vector<long>{2, 4, 6, 8, 12, 16, 24}));
+  EXPECT_THROW(parse_gbs_sequence("fibonacci"), std::invalid_argument);
+}
+
+TEST(Gbs, ManyShortSpansAgreeWithOneLongSpan) {
+  const KeplerProblem<double> prob{0.2};
+  GbsOptions o;
+  o.rtol = o.atol = 1e-13;
+  auto a = prob.initial_state(), b = a;
+  GbsIntegrator<std::array<double, 2>, KeplerForce> g1(KeplerForce{}, o), g2(KeplerForce{}, o);
+  g1.integrate(a, 0.01, 700);
+  g2.integrate_to(b, 7.0);
+  const auto ex = prob.exact(7.0);
+  EXPECT_LT(std::abs(a.q[0] - ex.q[0]), 1e-11);
+  EXPECT_LT(std::abs(b.q[0] - ex.q[0]), 1e-11);
+}
+
+TEST(Gbs, FollowsTheTwoBodyProblemAsAnNBodySystem) {
+  auto p = two_body(0.2);
+  NBodyForce<double> f(p.m, 0.0);
+  GbsOptions o;
+  o.rtol = o.atol = 1e-13;
+  GbsIntegrator<std::vector<double>, NBodyForce<double>> g(f, o);
+  const double t = 1.7 * 2 * M_PI;
+  g.integrate_to(p.s, t);
+  const auto ex = KeplerProblem<double>(0.2).exact(t);
+  // relative coordinates = body 1 - body 0
+  EXPECT_NEAR(p.s.q[1] - p.s.q[0], ex.q[0], 1e-10);
+  EXPECT_NEAR(p.s.q[3] - p.s.q[2], ex.q[1], 1e-10);
+  EXPECT_NEAR(p.s.v[1] - p.s.v[0], ex.v[0], 1e-10);
+}
+
+TEST(Gbs, RejectsBadOptionsAndStopsOnASingularity) {
+  GbsOptions o;
+  o.rtol = o.atol = 1e-17;
+  EXPECT_THROW((GbsIntegrator<std::array<double, 2>, KeplerForce>(KeplerForce{}, o)), std::invalid_argument);
+  o.rtol = o.atol = -1;
+  EXPECT_THROW((GbsIntegrator<std::array<double, 2>, KeplerForce>(KeplerForce{}, o)), std::invalid_argument);
+  o = GbsOptions{};
+  o.max_columns = 2;
+  EXPECT_THROW((GbsIntegrator<std::array<double, 2>, KeplerForce>(KeplerForce{}, o)), std::invalid_argument);
+  o = GbsOptions{};
+  GbsIntegrator<std::array<double, 2>, KeplerForce> g(KeplerForce{}, o);
+  auto s = KeplerProblem<double>(0.2).initial_state();
+  EXPECT_THROW(g.integrate_to(s, -1.0), std::invalid_argument);
+  // Head-on collision of two point masses at rest: the step size collapses; GBS must stop with an error.
+  NBodyForce<double> f({0.5, 0.5}, 0.0);
+  State<std::vector<double>> c{{-1, 1, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}};
+  GbsIntegrator<std::vector<double>, NBodyForce<double>> gc(f, o);
+  EXPECT_THROW(gc.integrate_to(c, 10.0), std::invalid_argument);
+}

@@ -1,0 +1,314 @@
+// N-body force (generic and SIMD kernels, real and complex, thread-count independence), two-body and
+// Plummer initial conditions, particle files, statistics.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "nystrom/diagnostics/stats.hpp"
+#include "nystrom/engines/splitting.hpp"
+#include "nystrom/problems/nbody.hpp"
+#include "nystrom/problems/plummer.hpp"
+
+using namespace nystrom;
+using C = std::complex<double>;
+
+namespace {
+
+std::vector<C> complexify(const std::vector<double>& q, double scale, unsigned seed) {
+  std::mt19937_64 g(seed);
+  std::vector<C> out(q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) out[i] = C(q[i], scale * (detail::uniform01(g) - 0.5));
+  return out;
+}
+
+template <class V>
+double max_rel_diff(const V& a, const V& b) {
+  double m = 0, s = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    m = std::max(m, std::abs(a[i] - b[i]));
+    s = std::max(s, std::abs(a[i]));
+  }
+  return m / s;
+}
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("nystrom_test_nbody_" + name)).string();
+}
+
+}  // namespace
+
+TEST(NBodyForce, TwoBodiesFollowNewton) {
+  NBodyForce<double> f({2.0, 3.0}, 0.0);
+  const std::vector<double> q = {0.0, 1.0, 0.0, 2.0, 0.0, 2.0};  // x0=0, x1=1; y0=0, y1=2; z0=0, z1=2: r = 3
+  std::vector<double> a;
+  f(q, a);
+  // a_0 = m_1 (q_1 - q_0) / r^3 = 3 (1, 2, 2) / 27;  a_1 = -m_0 (1, 2, 2) / 27
+  EXPECT_NEAR(a[0], 3.0 / 27, 1e-15);
+  EXPECT_NEAR(a[2], 6.0 / 27, 1e-15);
+  EXPECT_NEAR(a[4], 6.0 / 27, 1e-15);
+  EXPECT_NEAR(a[1], -2.0 / 27, 1e-15);
+  EXPECT_NEAR(a[3], -4.0 / 27, 1e-15);
+  EXPECT_NEAR(a[5], -4.0 / 27, 1e-15);
+  // Softening: r^2 -> r^2 + eps^2.
+  NBodyForce<double> g({2.0, 3.0}, 16.0);
+  g(q, a);
+  EXPECT_NEAR(a[0], 3.0 / 125, 1e-15);
+}
+
+TEST(NBodyForce, RejectsBadInput) {
+  EXPECT_THROW(NBodyForce<double>({}, 0.0), std::invalid_argument);
+  EXPECT_THROW(NBodyForce<double>({1.0, -1.0}, 0.0), std::invalid_argument);
+  EXPECT_THROW(NBodyForce<double>({1.0, NAN}, 0.0), std::invalid_argument);
+  EXPECT_THROW(NBodyForce<double>({1.0, 1.0}, -1.0), std::invalid_argument);
+  EXPECT_THROW(NBodyForce<double>({1.0, 1.0}, INFINITY), std::invalid_argument);
+  NBodyForce<double> f({1.0, 1.0}, 0.0);
+  std::vector<double> q(5, 0.0), a;
+  EXPECT_THROW(f(q, a), std::invalid_argument);
+  NBodyForce<double> empty;
+  EXPECT_THROW(empty(q, a), std::invalid_argument);
+}
+
+TEST(NBodyForce, ComplexInversePowerIsThePrincipalBranch) {
+  const double vals[] = {3.0, 0.5, -0.7, -2.0, 1e-3};
+  for (double a : vals)
+    for (double b : vals) {
+      double wr, wi;
+      detail::complex_inv_pow32(a, b, wr, wi);
+      const C ref = std::pow(C(a, b), -1.5);
+      EXPECT_NEAR(wr, ref.real(), 1e-13 * std::abs(ref)) << a << " " << b;
+      EXPECT_NEAR(wi, ref.imag(), 1e-13 * std::abs(ref)) << a << " " << b;
+    }
+  // On the negative real axis the sign of the zero imaginary part picks the side of the cut.
+  double wr, wi;
+  detail::complex_inv_pow32(-4.0, 0.0, wr, wi);
+  EXPECT_NEAR(wi, std::pow(C(-4.0, 0.0), -1.5).imag(), 1e-15);
+  detail::complex_inv_pow32(-4.0, -0.0, wr, wi);
+  EXPECT_NEAR(wi, std::pow(C(-4.0, -0.0), -1.5).imag(), 1e-15);
+}
+
+// The complex force is the analytic continuation: Im a(q + i d u) / d is the directional derivative of the
+// real force (complex-step differentiation), Re a(q + i d u) = a(q) + O(d^2).
+TEST(NBodyForce, ComplexForceIsTheAnalyticContinuation) {
+  for (auto kernel : {NBodyKernel::generic, NBodyKernel::simd}) {
+    if (kernel == NBodyKernel::simd && !nbody_simd_available()) continue;
+    auto p = plummer_sphere<double>(100, 7);
+    NBodyForce<double> f(p.m, 1e-4);
+    f.kernel = kernel;
+    std::vector<double> u(p.s.q.size());
+    std::mt19937_64 g(3);
+    for (auto& x : u) x = detail::uniform01(g) - 0.5;
+    const double d = 1e-20;
+    std::vector<C> qc(p.s.q.size()), ac;
+    for (std::size_t i = 0; i < u.size(); ++i) qc[i] = C(p.s.q[i], d * u[i]);
+    f(qc, ac);
+    const double fd = 1e-5;
+    std::vector<double> qp = p.s.q, qm = p.s.q, ap, am, a0;
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      qp[i] += fd * u[i];
+      qm[i] -= fd * u[i];
+    }
+    f(qp, ap);
+    f(qm, am);
+    f(p.s.q, a0);
+    double scale = 0, err_im = 0, err_re = 0;
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      const double deriv = (ap[i] - am[i]) / (2 * fd);
+      scale = std::max(scale, std::abs(deriv));
+      err_im = std::max(err_im, std::abs(ac[i].imag() / d - deriv));
+      err_re = std::max(err_re, std::abs(ac[i].real() - a0[i]) / std::max(1.0, std::abs(a0[i])));
+    }
+    EXPECT_LT(err_im / scale, 1e-6);
+    EXPECT_LT(err_re, 1e-12);
+  }
+}
+
+TEST(NBodyForce, SimdKernelAgreesWithGenericKernel) {
+  if (!nbody_simd_available()) GTEST_SKIP() << "no AVX-512 on this CPU: only the generic kernel runs";
+  for (std::size_t n : {64u, 301u, 1000u}) {
+    for (double eps2 : {0.0, 1.0 / (double(n) * double(n))}) {
+      auto p = plummer_sphere<double>(n, 11 + n);
+      NBodyForce<double> f(p.m, eps2);
+      std::vector<double> ag, as;
+      f.kernel = NBodyKernel::generic;
+      f(p.s.q, ag);
+      f.kernel = NBodyKernel::simd;
+      EXPECT_TRUE(f.uses_simd<double>());
+      f(p.s.q, as);
+      EXPECT_LT(max_rel_diff(ag, as), 1e-13) << "n = " << n << " eps2 = " << eps2;
+      const auto qc = complexify(p.s.q, 1e-3, 5);
+      std::vector<C> bg, bs;
+      f.kernel = NBodyKernel::generic;
+      f(qc, bg);
+      f.kernel = NBodyKernel::simd;
+      f(qc, bs);
+      EXPECT_LT(max_rel_diff(bg, bs), 1e-13) << "complex, n = " << n << " eps2 = " << eps2;
+    }
+  }
+}
+
+TEST(NBodyForce, ResultsDoNotDependOnTheThreadCount) {
+  auto p = plummer_sphere<double>(1500, 5);
+  const auto qc = complexify(p.s.q, 1e-3, 9);
+  for (auto kernel : {NBodyKernel::generic, NBodyKernel::simd}) {
+    if (kernel == NBodyKernel::simd && !nbody_simd_available()) continue;
+    NBodyForce<double> f(p.m, 1e-6);
+    f.kernel = kernel;
+    std::vector<double> a1, an;
+    std::vector<C> c1, cn;
+    f.threads = 1;
+    f(p.s.q, a1);
+    f(qc, c1);
+    for (int t : {2, 3, 4, 7}) {
+      f.threads = t;
+      f(p.s.q, an);
+      f(qc, cn);
+      EXPECT_TRUE(a1 == an) << "threads = " << t;  // bitwise
+      EXPECT_TRUE(c1 == cn) << "threads = " << t;
+    }
+  }
+}
+
+TEST(NBodyForce, ConservesMomentum) {
+  auto p = plummer_sphere<double>(500, 1);
+  NBodyForce<double> f(p.m, 1e-4);
+  std::vector<double> a;
+  f(p.s.q, a);
+  for (std::size_t c = 0; c < 3; ++c) {
+    double s = 0, mag = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      s += p.m[i] * a[c * p.size() + i];
+      mag += std::abs(p.m[i] * a[c * p.size() + i]);
+    }
+    EXPECT_LT(std::abs(s), 1e-13 * mag);
+  }
+}
+
+TEST(NBodyForce, LongDoubleAgreesWithDouble) {
+  auto p = plummer_sphere<double>(50, 2);
+  NBodyForce<double> f(p.m, 0.0);
+  std::vector<long double> m(p.m.begin(), p.m.end()), q(p.s.q.begin(), p.s.q.end()), al;
+  NBodyForce<long double> fl(m, 0.0L);
+  std::vector<double> a;
+  f(p.s.q, a);
+  fl(q, al);
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], static_cast<double>(al[i]), 1e-12 * (1 + std::abs(a[i])));
+}
+
+TEST(NBodyForce, IntegratesWithRealAndComplexSplittings) {
+  // Leapfrog conserves the energy of a softened Plummer sphere to O(h^2); the complex third-order method
+  // of Chambers (imaginary parts dropped after each step) does better at the same step.
+  auto p = plummer_sphere<double>(64, 3);
+  NBodyForce<double> f(p.m, 1.0 / (64.0 * 64.0));
+  const double e0 = nbody_energy(f, p.s);
+  SplittingScheme<double> lf{{{Flow::kick, 0.5}, {Flow::drift, 1.0}, {Flow::kick, 0.5}}};
+  SplittingStepper<std::vector<double>, NBodyForce<double>> st(lf, f);
+  auto s = p.s;
+  st.integrate(s, 1e-3, 200);
+  const double dlf = std::abs(nbody_energy(f, s) - e0);
+  EXPECT_LT(dlf, 1e-5);
+  const C a1(0.25, 0.25 / std::sqrt(3.0));
+  SplittingScheme<C> ch{{{Flow::drift, a1}, {Flow::kick, 2.0 * a1}, {Flow::drift, C(0.5)}, {Flow::kick, std::conj(2.0 * a1)},
+                         {Flow::drift, std::conj(a1)}}};
+  SplittingStepper<std::vector<C>, NBodyForce<double>> sc(ch, f);
+  auto z = convert_state<std::vector<C>>(p.s);
+  sc.integrate(z, 1e-3, 200);
+  const auto zr = convert_state<std::vector<double>>(z);
+  const double dch = std::abs(nbody_energy(f, zr) - e0);
+  EXPECT_LT(dch, dlf);
+}
+
+TEST(TwoBody, IsTheKeplerOrbitInTheCentreOfMassFrame) {
+  const auto p = two_body(0.2);
+  ASSERT_EQ(p.size(), 2u);
+  // relative position (1.2, 0, 0), relative velocity (0, sqrt(0.8/1.2), 0); total momentum zero
+  EXPECT_DOUBLE_EQ(p.s.q[1] - p.s.q[0], 1.2);
+  EXPECT_NEAR(p.s.v[3] - p.s.v[2], std::sqrt(0.8 / 1.2), 1e-15);
+  EXPECT_EQ(p.m[0] * p.s.v[2] + p.m[1] * p.s.v[3], 0.0);
+  NBodyForce<double> f(p.m, 0.0);
+  // E = -G m1 m2 / (2a) = -1/8
+  EXPECT_NEAR(nbody_energy(f, p.s), -0.125, 1e-15);
+  EXPECT_THROW(two_body(1.0), std::invalid_argument);
+  EXPECT_THROW(two_body(-0.1), std::invalid_argument);
+}
+
+TEST(Plummer, IsReproducibleAndInStandardUnits) {
+  const auto a = plummer_sphere<double>(1000, 42), b = plummer_sphere<double>(1000, 42), c = plummer_sphere<double>(1000, 43);
+  EXPECT_TRUE(a.s.q == b.s.q && a.s.v == b.s.v);
+  EXPECT_FALSE(a.s.q == c.s.q);
+  EXPECT_NEAR(particle_energy(a), -0.25, 1e-13);
+  const auto pc = nbody_momentum_and_centre(a.m, a.s);
+  for (double x : pc) EXPECT_NEAR(x, 0.0, 1e-15);
+  // Virial ratio 2T/|W| near 1, half-mass radius near 0.769 (Plummer: 1.305 a with a = 3 pi / 16).
+  const double T = nbody_kinetic_energy(a.m, a.s.v), W = nbody_potential_energy(a.m, 0.0, a.s.q);
+  EXPECT_NEAR(2 * T / -W, 1.0, 0.15);
+  std::vector<double> r(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    r[i] = std::sqrt(a.s.q[i] * a.s.q[i] + a.s.q[1000 + i] * a.s.q[1000 + i] + a.s.q[2000 + i] * a.s.q[2000 + i]);
+  EXPECT_NEAR(median(r), 0.769, 0.08);
+  EXPECT_THROW(plummer_sphere<double>(1, 1), std::invalid_argument);
+}
+
+TEST(ParticleFile, RoundTripsBitForBit) {
+  const auto p = plummer_sphere<double>(37, 9);
+  const std::string path = temp_path("roundtrip.csv");
+  save_particles(path, p);
+  const auto q = load_particles<double>(path);
+  EXPECT_TRUE(p.m == q.m && p.s.q == q.s.q && p.s.v == q.s.v);
+  std::filesystem::remove(path);
+}
+
+TEST(ParticleFile, RejectsMalformedFiles) {
+  const std::string path = temp_path("bad.csv");
+  auto check = [&](const std::string& text, const std::string& what) {
+    {
+      std::ofstream(path) << text;
+    }
+    try {
+      load_particles<double>(path);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("line"), std::string::npos) << e.what();
+    }
+  };
+  const std::string ok = "1,0,0,0,0,0,0\n";
+  check(ok + "1,0,0,0,0,0\n", "six numbers");
+  check(ok + "1,0,0,0,0,0,0,0\n", "eight numbers");
+  check(ok + "1,0,0,x,0,0,0\n", "not a number");
+  check(ok + "1,0,0,1e999,0,0,0\n", "overflow");
+  check(ok + "-1,0,0,0,0,0,0\n", "negative mass");
+  check(ok + "0,0,0,0,0,0,0\n", "zero mass");
+  check(ok + "1,0,0,nan,0,0,0\n", "nan");
+  check(ok + "1,0,0,0.5.5,0,0,0\n", "two points");
+  {
+    std::ofstream(path) << "# only a comment\n\n";
+  }
+  EXPECT_THROW(load_particles<double>(path), std::invalid_argument);
+  {
+    std::ofstream(path) << "m,x,y,z,vx,vy,vz\n# c\n0.5 1 0 0 0 0.5 0\n\n0.5,-1,0,0,0,-0.5,0\n";
+  }
+  const auto p = load_particles<double>(path);
+  EXPECT_EQ(p.size(), 2u);
+  EXPECT_EQ(p.s.v[2], 0.5);  // vy of particle 0
+  std::filesystem::remove(path);
+  EXPECT_THROW(load_particles<double>(temp_path("does-not-exist.csv")), std::invalid_argument);
+  EXPECT_THROW(save_particles("/nonexistent-dir/x.csv", p), std::invalid_argument);
+}
+
+TEST(Stats, QuantilesInterpolateLinearly) {
+  EXPECT_DOUBLE_EQ(quantile(std::vector<double>{4, 1, 3, 2}, 0.25), 1.75);
+  EXPECT_DOUBLE_EQ(quantile(std::vector<double>{4, 1, 3, 2}, 0.75), 3.25);
+  EXPECT_DOUBLE_EQ(interquartile_range(std::vector<double>{4, 1, 3, 2}), 1.5);
+  EXPECT_DOUBLE_EQ(quantile(std::vector<double>{5}, 0.3), 5.0);
+  EXPECT_DOUBLE_EQ(median(std::vector<double>{3, 1, 2}), 2.0);
+  EXPECT_DOUBLE_EQ(quantile(std::vector<double>{1, 2, 3}, 1.0), 3.0);
+  EXPECT_THROW(quantile(std::vector<double>{}, 0.5), std::invalid_argument);
+  EXPECT_THROW(quantile(std::vector<double>{1, NAN}, 0.5), std::invalid_argument);
+  EXPECT_THROW(quantile(std::vector<double>{1}, 1.5), std::invalid_argument);
+}
