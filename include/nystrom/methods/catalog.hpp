@@ -6,6 +6,10 @@
 //   mpe:1,2,4             MPE on position Verlet with the given sequence
 //   mpe-vv:1,2,3          MPE on velocity Verlet
 //   adjoint:NAME          the adjoint of a splitting method (sub-steps reversed)
+//   triplejump:P          Yoshida's triple jump of even order P on position Verlet (also triplejump-pv:P);
+//   triplejump-vv:P       on velocity Verlet (compositions.hpp)
+//   suzuki:P              Suzuki's 5-fold fractal composition of even order P on position Verlet
+//   suzuki-vv:P           (also suzuki-pv:P) and on velocity Verlet
 #pragma once
 
 #include <algorithm>
@@ -16,8 +20,11 @@
 #include <string>
 #include <vector>
 
+#include "nystrom/methods/blanes_moan2002.hpp"
 #include "nystrom/methods/chin2010.hpp"
+#include "nystrom/methods/compositions.hpp"
 #include "nystrom/methods/dormand_prince1987.hpp"
+#include "nystrom/methods/gurkan.hpp"
 #include "nystrom/methods/method.hpp"
 
 namespace nystrom {
@@ -41,6 +48,10 @@ inline void finalize_info(MethodDef& d) {
     in.fsal = s.fsal();
     in.complex = std::any_of(s.steps.begin(), s.steps.end(), [](const auto& x) { return !x.coef.is_real(); });
     if (in.complex) in.symplectic = false;  // imaginary parts are dropped after each step
+    if (in.complex && in.fsal) {  // ... so the last force, taken at a complex position, is not reusable
+      in.fsal = false;
+      ++in.forces_per_step;
+    }
   } else if (const auto* t = std::get_if<RknTableau<bigcomplex>>(&data)) {
     in.stages = static_cast<int>(t->stages());
     in.forces_per_step = t->forces_per_step();
@@ -74,6 +85,9 @@ inline const std::vector<MethodDef>& catalog() {
     };
     add(methods::chin2010());
     add(methods::chin2010_mpe());
+    add(methods::compositions());
+    add(methods::blanes_moan2002());
+    add(methods::gurkan());
     add(methods::dormand_prince1987());
     for (auto& d : v) detail::finalize_info(d);
     return v;
@@ -108,6 +122,18 @@ inline MethodDef resolve_method(const std::string& spec) {
     for (long i = 1; i <= order / 2; ++i) k.push_back(i);
     return finalize(methods::mpe_method(k, "PV", "M" + std::to_string(order)));
   }
+  for (const auto& [prefix, base] : {std::pair<std::string, std::string>{"triplejump:", "PV"},
+                                     {"triplejump-pv:", "PV"},
+                                     {"triplejump-vv:", "VV"}})
+    if (ls.rfind(prefix, 0) == 0)
+      return finalize(methods::triple_jump_method(methods::parse_composition_order(spec.substr(prefix.size()), spec),
+                                                  base, ls));
+  for (const auto& [prefix, base] : {std::pair<std::string, std::string>{"suzuki:", "PV"},
+                                     {"suzuki-pv:", "PV"},
+                                     {"suzuki-vv:", "VV"}})
+    if (ls.rfind(prefix, 0) == 0)
+      return finalize(
+          methods::suzuki_method(methods::parse_composition_order(spec.substr(prefix.size()), spec), base, ls));
   if (ls.rfind("adjoint:", 0) == 0) {
     MethodDef base = resolve_method(spec.substr(8));
     auto build = base.build;
