@@ -428,7 +428,7 @@ RknTableau<C> to_rkn_tableau(const SplittingScheme<C>& scheme, double drift_tole
     }
   }
   if (B.empty()) throw std::invalid_argument("splitting scheme has no kick: it has no RKN tableau");
-  const double defect = static_cast<double>(rkn_abs(C(drift - C(1))));
+  const double defect = as_double(rkn_abs(C(drift - C(1))));
   if (!(defect <= drift_tolerance))
     throw std::invalid_argument("splitting scheme is not consistent: its drifts add up to 1 + " +
                                 std::to_string(defect) + " (in magnitude), not 1");
