@@ -25,8 +25,8 @@ template <class S>
 std::vector<S> mpe_coefficients_as(const MpeCoefficients& mc) {
   using T = real_t<S>;
   const double amp = mpe_amplification(mc);
-  const double eps = std::ldexp(1.0, static_cast<int>(1 - scalar_traits<T>::bits()));
-  if (!(amp * eps < std::sqrt(eps)))
+  // amp * eps < sqrt(eps), in logarithms (eps = 2^(1-bits) underflows a double beyond 1074 bits).
+  if (!(std::log2(amp) < 0.5 * static_cast<double>(scalar_traits<T>::bits() - 1)))
     throw std::invalid_argument("MPE order " + std::to_string(mc.order()) + " is beyond what " + scalar_traits<T>::name() +
                                 " can represent: the coefficients amplify rounding by " + std::to_string(amp) +
                                 " (use a wider --precision)");
@@ -83,8 +83,12 @@ class Integrator {
 template <class V, class F>
 Integrator<V, F> make_integrator(const MethodDef& def, F force, EngineOptions opt = {}) {
   using T = real_t<typename V::value_type>;
-  BigPrecision guard(reference_bits(scalar_traits<T>::bits()));
-  const MethodData data = def.build();
+  const MethodData data = [&] {
+    BigPrecision guard(reference_bits(scalar_traits<T>::bits()));
+    return def.build();
+  }();
+  // The working values are created outside the guard: for run-time-precision types (mpfr_real) the
+  // reference precision must not leak into the working precision.
   return Integrator<V, F>(data, std::move(force), opt);
 }
 
