@@ -59,7 +59,7 @@ double parse_double(const std::string& text, const std::string& what, bool posit
   return v;
 }
 
-std::vector<double> parse_log_range(const std::string& text, const std::string& what) {
+std::vector<double> parse_log_range(const std::string& text, const std::string& what, bool allow_decreasing) {
   std::vector<std::string> parts;
   std::stringstream ss(text);
   std::string item;
@@ -70,7 +70,7 @@ std::vector<double> parse_log_range(const std::string& text, const std::string& 
   const double hi = parse_double(parts[1], what + " end", true);
   const double cnt = parse_double(parts[2], what + " count", true);
   if (cnt != std::floor(cnt) || cnt > 10000) throw UsageError(what + " count must be a whole number up to 10000");
-  if (hi < lo) throw UsageError(what + ": end must not be below start");
+  if (hi < lo && !allow_decreasing) throw UsageError(what + ": end must not be below start");
   const int n = static_cast<int>(cnt);
   std::vector<double> v;
   for (int i = 0; i < n; ++i)

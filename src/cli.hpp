@@ -49,7 +49,8 @@ void write_file_atomic(const std::string& path, const std::string& content);
 double parse_double(const std::string& text, const std::string& what, bool positive = false);
 
 /// "1e3:1e6:20" -> 20 values spaced evenly in log between 1e3 and 1e6 (inclusive).
-std::vector<double> parse_log_range(const std::string& text, const std::string& what);
+/// With allow_decreasing, TO may be below FROM (e.g. tolerances 1e-6:1e-14:9).
+std::vector<double> parse_log_range(const std::string& text, const std::string& what, bool allow_decreasing = false);
 
 /// Splits "a,b,c"; empty items are errors.
 std::vector<std::string> split_list(const std::string& text, const std::string& what);

@@ -24,6 +24,7 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--steps-per-period", o->req.steps_per_period, "Steps per orbital period")->capture_default_str();
   app.add_option("--periods", o->req.periods, "Number of whole periods")->capture_default_str();
   app.add_option("--precision", o->req.precision, "Scalar type (double, long-double, ...)")->capture_default_str();
+  app.add_option("--tol", o->req.tol, "Tolerance of an adaptive method (e.g. DP12-adaptive)");
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
   app.add_flag("--json", o->json, "Print one JSON object");
   return [o]() {

@@ -18,6 +18,7 @@ struct Options {
   nystrom::cli::RunRequest base;
   std::string methods = "FR,N4,M4,M6,A6";
   std::string evals = "1e3:1e6:20";
+  std::string tols;
   std::string csv, plot, metric = "precession";
   bool json = false;
 };
@@ -31,6 +32,7 @@ nystrom::cli::Registrar reg("sweep", "Error against force evaluations for severa
                               app.add_option("--methods", o->methods, "Comma-separated methods")->capture_default_str();
                               app.add_option("--force-evals", o->evals, "FROM:TO:COUNT force evaluations per period (log-spaced)")
                                   ->capture_default_str();
+                              app.add_option("--tols", o->tols, "FROM:TO:COUNT tolerances for adaptive methods");
                               app.add_option("--periods", o->base.periods, "Periods integrated per run")->capture_default_str();
                               app.add_option("--precision", o->base.precision, "Scalar type")->capture_default_str();
                               app.add_option("--error", o->metric, "Error measure: precession, position, energy")
@@ -44,6 +46,7 @@ nystrom::cli::Registrar reg("sweep", "Error against force evaluations for severa
                                 req.base = o->base;
                                 req.methods = split_list(o->methods, "--methods");
                                 req.force_evals = parse_log_range(o->evals, "--force-evals");
+                                if (!o->tols.empty()) req.tols = parse_log_range(o->tols, "--tols", true);
                                 sweep_error(SweepRow{}, o->metric);  // validate the measure before running
                                 const auto rows = run_sweep(req);
                                 if (!o->csv.empty()) write_file_atomic(o->csv, sweep_csv(rows));

@@ -79,14 +79,18 @@ RunReport run_case(const RunRequest& req, const MethodDef& def) {
   if (req.periods <= 0) throw UsageError("--periods must be a positive integer");
   if (req.steps_per_period > 1'000'000'000L / req.periods)
     throw UsageError("too many steps requested (steps-per-period x periods must be at most 1e9)");
-  if (def.info.adaptive)
-    throw UsageError("method '" + def.info.name + "' is adaptive; `run` integrates with fixed steps only");
+  if (def.info.adaptive && !(req.tol > 0 && std::isfinite(req.tol)))
+    throw UsageError("method '" + def.info.name + "' is adaptive: give a positive --tol");
+  if (!def.info.adaptive && req.tol != 0)
+    throw UsageError("--tol applies to adaptive methods only; '" + def.info.name + "' runs with fixed steps");
   RunReport r = dispatch_precision(req.precision, [&](auto tag) -> RunReport {
     using T = typename decltype(tag)::type;
     if (req.problem == "kepler") {
       if (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1)
         throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
-      const auto k = run_kepler<T>(def, req.ecc, req.steps_per_period, req.periods, EngineOptions{req.keep_complex});
+      const auto k = def.info.adaptive
+                         ? run_kepler_adaptive<T>(def, req.ecc, req.tol, req.periods)
+                         : run_kepler<T>(def, req.ecc, req.steps_per_period, req.periods, EngineOptions{req.keep_complex});
       RunReport out;
       out.ecc = req.ecc;
       out.steps = k.steps;
@@ -98,7 +102,10 @@ RunReport run_case(const RunRequest& req, const MethodDef& def) {
       out.seconds = k.seconds;
       return out;
     }
-    if (req.problem == "harmonic") return run_harmonic<T>(req, def);
+    if (req.problem == "harmonic") {
+      if (def.info.adaptive) throw UsageError("adaptive methods run on the kepler problem only");
+      return run_harmonic<T>(req, def);
+    }
     std::string known;
     for (const auto& p : problem_names()) known += (known.empty() ? "" : ", ") + p;
     throw UsageError("unknown problem '" + req.problem + "' (known: " + known + ")");

@@ -18,6 +18,7 @@ struct RunRequest {
   long periods = 10;               // whole periods integrated
   std::string precision = "double";
   bool keep_complex = false;       // complex methods: keep the complexified state
+  double tol = 0;                  // adaptive methods: tolerance (required for them, refused otherwise)
 };
 
 struct RunReport {

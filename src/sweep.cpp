@@ -16,10 +16,28 @@ std::vector<SweepRow> run_sweep(const SweepRequest& req) {
   if (req.force_evals.empty()) throw UsageError("no force-evaluation counts given");
   std::vector<MethodDef> defs;
   for (const auto& m : req.methods) defs.push_back(resolve_method(m));  // fail early on unknown names
+  long total = 0;
+  for (const auto& def : defs) {
+    if (def.info.adaptive && req.tols.empty())
+      throw UsageError("method '" + def.info.name + "' is adaptive: give --tols FROM:TO:COUNT");
+    total += static_cast<long>(def.info.adaptive ? req.tols.size() : req.force_evals.size());
+  }
   std::vector<SweepRow> rows;
-  Progress progress("sweep", static_cast<long>(defs.size() * req.force_evals.size()));
+  Progress progress("sweep", total);
   long done = 0;
   for (const auto& def : defs) {
+    if (def.info.adaptive) {
+      for (double tol : req.tols) {
+        RunRequest r = req.base;
+        r.tol = tol;
+        progress.tick(++done);
+        SweepRow row;
+        row.report = run_case(r, def);
+        row.force_evals_per_period = static_cast<double>(row.report.force_evals) / static_cast<double>(r.periods);
+        rows.push_back(row);
+      }
+      continue;
+    }
     const int f = std::max(1, def.info.forces_per_step);
     long last_steps = -1;
     for (double N : req.force_evals) {
@@ -78,11 +96,11 @@ void sweep_plot(const std::vector<SweepRow>& rows, const std::string& metric, co
 }
 
 void sweep_table(const std::vector<SweepRow>& rows, const std::string& metric) {
-  fmt::print("{:<12} {:>5} {:>12} {:>10} {:>14} {:>12} {:>12} {:>9}\n", "method", "order", "N/period", "steps",
+  fmt::print("{:<14} {:>5} {:>12} {:>10} {:>14} {:>12} {:>12} {:>9}\n", "method", "order", "N/period", "steps",
              metric == "precession" ? "|dtheta|/per" : metric, "energy err", "pos err", "seconds");
   for (const auto& r : rows) {
     const auto& p = r.report;
-    fmt::print("{:<12} {:>5} {:>12.0f} {:>10} {:>14.3e} {:>12.3e} {:>12.3e} {:>9.4f}\n", p.method, p.order,
+    fmt::print("{:<14} {:>5} {:>12.0f} {:>10} {:>14.3e} {:>12.3e} {:>12.3e} {:>9.4f}\n", p.method, p.order,
                r.force_evals_per_period, p.steps, sweep_error(r, metric), p.energy_error, p.position_error, p.seconds);
   }
 }

@@ -17,9 +17,11 @@ struct SweepRequest {
   RunRequest base;                     // problem, ecc, periods, precision
   std::vector<std::string> methods;
   std::vector<double> force_evals;     // target force evaluations per period
+  std::vector<double> tols;            // adaptive methods run once per tolerance instead
 };
 
 /// Runs every (method, N); N is turned into steps per period as round(N / forces_per_step).
+/// Adaptive methods run once per tolerance in `tols`; their N is the force evaluations they spent.
 std::vector<SweepRow> run_sweep(const SweepRequest& req);
 
 /// The error plotted and tabulated: "precession" (|dtheta| per period), "position" or "energy".

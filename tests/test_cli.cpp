@@ -115,6 +115,15 @@ TEST(Cli, RunReproducesChinFig1ErrorCoefficientsAtE09) {
   EXPECT_NEAR(eP("Aprime"), -1.4e4, 0.06e4);
 }
 
+TEST(Cli, AdaptiveMethodMeetsItsTolerance) {
+  const auto r = run("run --method DP12-adaptive --tol 1e-12 --ecc 0.9 --periods 2 --precision long-double --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_LT(j["position_error"].get<double>(), 1e-9);
+  EXPECT_GT(j["steps"].get<long>(), 10);
+  EXPECT_EQ(j["force_evals"].get<long>() % 17, 2);  // 17 per attempted step + 2 for the starting step
+}
+
 TEST(Cli, SweepWritesCsvAndPlot) {
   const auto dir = temp_dir();
   const auto csv = dir / "s.csv", png = dir / "s.png";
@@ -161,6 +170,9 @@ TEST(Cli, BadInputIsOneClearLineAndExitCode2) {
       "run --method mpe:1,,2",                                   // malformed sequence
       "run --method M7",                                         // odd order
       "run --method M80",                                        // order beyond double
+      "run --method DP12-adaptive",                              // adaptive without --tol
+      "run --method DP12-adaptive --tol -1",                     //
+      "run --method M4 --tol 1e-3",                              // --tol on a fixed-step method
       "coeffs mpe --seq 1,2,x",                                  //
       "coeffs mpe",                                              // nothing asked
       "sweep --methods FR --force-evals 1e3:1e2:5",              // decreasing range

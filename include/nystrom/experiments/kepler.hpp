@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
@@ -27,6 +28,54 @@ struct KeplerRunResult {
   double position_error = 0;         // |q - q_exact| at the end
   double seconds = 0;
 };
+
+namespace detail {
+
+/// Fills the diagnostics of a finished Kepler run from the initial and final states.
+template <class T>
+void kepler_diagnostics(KeplerRunResult& r, const KeplerProblem<T>& prob, const State<std::array<T, 2>>& s0,
+                        const State<std::array<T, 2>>& s, const T& t_end, long periods) {
+  using std::abs;
+  using std::sqrt;
+  const T angle = signed_angle(lrl_vector(s0), lrl_vector(s));
+  r.precession_per_period = as_double(angle / T(periods));
+  const T e0 = kepler_energy(s0);
+  r.energy_error = as_double(abs((kepler_energy(s) - e0) / e0));
+  const auto ex = prob.exact(t_end);
+  const T dx = s.q[0] - ex.q[0], dy = s.q[1] - ex.q[1];
+  r.position_error = as_double(sqrt(dx * dx + dy * dy));
+}
+
+}  // namespace detail
+
+/// Integrates `periods` orbits with an adaptive method (embedded pair) at tolerance `tol`, in real type T.
+/// `steps` in the result counts accepted steps.
+template <class T>
+KeplerRunResult run_kepler_adaptive(const MethodDef& def, double ecc, double tol, long periods) {
+  if (periods <= 0) throw std::invalid_argument("number of periods must be positive");
+  if (!std::isfinite(ecc)) throw std::invalid_argument("eccentricity is not finite");
+  const KeplerProblem<T> prob(static_cast<T>(ecc));
+  AdaptiveOptions opt;
+  opt.tol = tol;
+  auto integ = make_adaptive_integrator<std::array<T, 2>>(def, KeplerForce{}, opt);
+  const auto s0 = prob.initial_state();
+  auto s = s0;
+  const T t_end = KeplerProblem<T>::period() * T(periods);
+  const auto t0 = std::chrono::steady_clock::now();
+  const AdaptiveStats st = integ.integrate_to(s, T(0), t_end);
+  const auto t1 = std::chrono::steady_clock::now();
+  KeplerRunResult r;
+  r.method = def.info.name;
+  r.order = def.info.order;
+  r.precision = scalar_traits<T>::name();
+  r.ecc = ecc;
+  r.steps = st.accepted;
+  r.force_evals = st.force_evals;
+  r.h = as_double(t_end / T(st.accepted > 0 ? st.accepted : 1));  // mean accepted step
+  r.seconds = std::chrono::duration<double>(t1 - t0).count();
+  detail::kepler_diagnostics(r, prob, s0, s, t_end, periods);
+  return r;
+}
 
 /// Integrates `periods` orbits with `steps_per_period` steps each, in real type T.
 template <class T>
@@ -65,15 +114,7 @@ KeplerRunResult run_kepler(const MethodDef& def, double ecc, long steps_per_peri
   r.force_evals = evals;
   r.h = as_double(h);
   r.seconds = std::chrono::duration<double>(t1 - t0).count();
-  using std::abs;
-  using std::sqrt;
-  const T angle = signed_angle(lrl_vector(s0), lrl_vector(s));
-  r.precession_per_period = as_double(angle / T(periods));
-  const T e0 = kepler_energy(s0);
-  r.energy_error = as_double(abs((kepler_energy(s) - e0) / e0));
-  const auto ex = prob.exact(h * T(n));
-  const T dx = s.q[0] - ex.q[0], dy = s.q[1] - ex.q[1];
-  r.position_error = as_double(sqrt(dx * dx + dy * dy));
+  detail::kepler_diagnostics(r, prob, s0, s, h * T(n), periods);
   return r;
 }
 
