@@ -1,0 +1,393 @@
+// Structural properties of every catalog method, checked on one step of planar Kepler:
+//
+//  (a) Symmetry (time reversibility): a symmetric method satisfies Phi_{-h} o Phi_h = id. One step
+//      forward with h and one with -h must return to the start to rounding (a few hundred ulps of
+//      long double, relative to the size of the state). Non-symmetric methods must NOT: their defect
+//      is O(h^(p+1)) (O(h^(p+2)) for even p), far above rounding at h = 0.25 -- which shows that the
+//      check discriminates.
+//  (b) Symplecticity: the Jacobian J of the one-step map (q, v) -> (q', v') satisfies J^T Omega J = Omega,
+//      Omega = [[0, I], [-I, 0]]. J is computed exactly (to rounding) by running the library's engines
+//      in a forward-mode dual-number scalar type defined here (value + gradient over the 4 phase-space
+//      coordinates). The check must hold for methods declared symplectic and fail, by far, for the
+//      non-symplectic RKN methods (N4, M4, ...). Two problems: Kepler, and Henon-Heiles, whose force is
+//      not central (on Kepler Chin's A' is symplectic, see HenonHeilesForce). That the engines run unchanged on this type shows they
+//      are generic in the scalar type; the value part is checked to be bit-identical to long double,
+//      and the derivative part against finite differences.
+//
+// Both loops read nystrom::catalog() at run time. Adaptive methods are skipped (they step with
+// their own controller). Complex-coefficient methods run (a) with complex state, imaginary parts
+// dropped after each step; they are skipped in (b): std::complex is specified only for float,
+// double and long double, so std::complex<Dual> is not a supported type, and with the imaginary
+// parts dropped the map is not symplectic anyway (finalize_info clears `symplectic` for them).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <complex>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "nystrom/nystrom.hpp"
+
+// ---- a forward-mode dual number --------------------------------------------------------------------
+
+namespace dualnum {
+
+/// x + sum_k d_k eps_k with eps_j eps_k = 0: value and gradient over N independent variables.
+/// Arithmetic on the value is exactly long double arithmetic (same operations, same order).
+template <std::size_t N>
+struct Dual {
+  long double v = 0;
+  std::array<long double, N> d{};
+
+  Dual() = default;
+  template <class A, std::enable_if_t<std::is_arithmetic_v<A>, int> = 0>
+  Dual(A x) : v(static_cast<long double>(x)) {}  // NOLINT: implicit, like a builtin floating type
+  explicit operator double() const { return static_cast<double>(v); }
+  explicit operator long double() const { return v; }
+
+  static Dual variable(long double x, std::size_t k) {
+    Dual r(x);
+    r.d[k] = 1;
+    return r;
+  }
+
+  Dual operator-() const {
+    Dual r;
+    r.v = -v;
+    for (std::size_t k = 0; k < N; ++k) r.d[k] = -d[k];
+    return r;
+  }
+  Dual& operator+=(const Dual& o) {
+    v += o.v;
+    for (std::size_t k = 0; k < N; ++k) d[k] += o.d[k];
+    return *this;
+  }
+  Dual& operator-=(const Dual& o) {
+    v -= o.v;
+    for (std::size_t k = 0; k < N; ++k) d[k] -= o.d[k];
+    return *this;
+  }
+  Dual& operator*=(const Dual& o) {
+    for (std::size_t k = 0; k < N; ++k) d[k] = d[k] * o.v + v * o.d[k];
+    v *= o.v;
+    return *this;
+  }
+  Dual& operator/=(const Dual& o) {
+    const long double q = v / o.v;
+    for (std::size_t k = 0; k < N; ++k) d[k] = (d[k] - q * o.d[k]) / o.v;
+    v = q;
+    return *this;
+  }
+  friend Dual operator+(Dual a, const Dual& b) { return a += b; }
+  friend Dual operator-(Dual a, const Dual& b) { return a -= b; }
+  friend Dual operator*(Dual a, const Dual& b) { return a *= b; }
+  friend Dual operator/(Dual a, const Dual& b) { return a /= b; }
+
+  // Equality is identity of value and gradient (the engines use it to decide whether a cached
+  // force belongs to the current position); ordering looks at the value only.
+  friend bool operator==(const Dual& a, const Dual& b) { return a.v == b.v && a.d == b.d; }
+  friend bool operator!=(const Dual& a, const Dual& b) { return !(a == b); }
+  friend bool operator<(const Dual& a, const Dual& b) { return a.v < b.v; }
+  friend bool operator>(const Dual& a, const Dual& b) { return a.v > b.v; }
+  friend bool operator<=(const Dual& a, const Dual& b) { return a.v <= b.v; }
+  friend bool operator>=(const Dual& a, const Dual& b) { return a.v >= b.v; }
+
+  friend Dual sqrt(const Dual& a) {
+    Dual r;
+    r.v = std::sqrt(a.v);
+    for (std::size_t k = 0; k < N; ++k) r.d[k] = a.d[k] / (2 * r.v);
+    return r;
+  }
+  friend Dual abs(const Dual& a) { return a.v < 0 ? -a : a; }
+  friend bool isfinite(const Dual& a) {
+    if (!std::isfinite(a.v)) return false;
+    for (auto x : a.d)
+      if (!std::isfinite(x)) return false;
+    return true;
+  }
+};
+
+}  // namespace dualnum
+
+using Dual4 = dualnum::Dual<4>;
+
+namespace nystrom {
+template <>
+struct scalar_traits<Dual4> {
+  static std::string name() { return "dual4<long-double>"; }
+  static long bits() { return std::numeric_limits<long double>::digits; }
+  static Dual4 from_mpfr(mpfr_srcptr x) { return Dual4(mpfr_get_ld(x, MPFR_RNDN)); }
+};
+}  // namespace nystrom
+
+using namespace nystrom;
+
+namespace {
+
+constexpr long double kEps = std::numeric_limits<long double>::epsilon();  // 2^-63
+
+std::vector<std::string> catalog_names() {
+  std::vector<std::string> names;
+  for (const auto& d : catalog()) names.push_back(d.info.name);
+  return names;
+}
+
+const MethodDef& find_in_catalog(const std::string& name) {
+  for (const auto& d : catalog())
+    if (d.info.name == name) return d;
+  throw std::invalid_argument("no catalog entry '" + name + "'");
+}
+
+std::string test_name(const testing::TestParamInfo<std::string>& info) {
+  std::string s;
+  for (char c : info.param) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return s + "_" + std::to_string(info.index);
+}
+
+/// A generic point of the e = 0.5 orbit (neither apocentre nor pericentre), in long double.
+State<std::array<long double, 2>> start_state() { return KeplerProblem<long double>(0.5L).exact(1.0L); }
+
+/// The step size of both checks: large enough that O(h^(p+1)) defects of non-symmetric and
+/// non-symplectic methods of order <= 6 are many orders of magnitude above rounding.
+constexpr long double kStep = 0.25L;
+
+// ---- (a) symmetry -----------------------------------------------------------------------------------
+
+/// max |Phi_{-h}(Phi_h(x0)) - x0| / max |x0|, in units of long double epsilon.
+double reversal_defect_ulps(const MethodDef& def, long double h) {
+  const auto s0 = start_state();
+  State<std::array<long double, 2>> s;
+  if (def.info.complex) {
+    using C = std::complex<long double>;
+    auto integ = make_integrator<std::array<C, 2>>(def, KeplerForce{});
+    auto sc = convert_state<std::array<C, 2>>(s0);
+    integ.step(sc, h);
+    integ.step(sc, -h);
+    s = convert_state<std::array<long double, 2>>(sc);
+  } else {
+    auto integ = make_integrator<std::array<long double, 2>>(def, KeplerForce{});
+    s = s0;
+    integ.step(s, h);
+    integ.step(s, -h);
+  }
+  long double size = 0, diff = 0;
+  for (int i = 0; i < 2; ++i) {
+    size = std::max({size, std::abs(s0.q[i]), std::abs(s0.v[i])});
+    diff = std::max({diff, std::abs(s.q[i] - s0.q[i]), std::abs(s.v[i] - s0.v[i])});
+  }
+  return static_cast<double>(diff / size / kEps);
+}
+
+/// A symmetric method returns to within this many ulps (measured: at most a few tens).
+constexpr double kReversalUlps = 300;
+
+class Symmetry : public testing::TestWithParam<std::string> {};
+
+}  // namespace
+
+TEST_P(Symmetry, DeclaredSymmetricMethodsRetraceTheirSteps) {
+  const MethodDef& def = find_in_catalog(GetParam());
+  if (def.info.adaptive) GTEST_SKIP() << def.info.name << " is adaptive (its own step-size controller)";
+  const double ulps = reversal_defect_ulps(def, kStep);
+  std::cout << "[ reverse  ] " << std::left << std::setw(16) << def.info.name << (def.info.symmetric ? " symmetric " : " -         ")
+            << " order " << std::setw(2) << def.info.order << "  defect " << std::setprecision(3) << ulps << " ulps"
+            << std::endl;
+  if (def.info.symmetric) {
+    EXPECT_LT(ulps, kReversalUlps) << def.info.name << " is declared symmetric but does not retrace its step";
+  } else if (def.info.order <= 6 && !def.info.complex) {
+    // An O(h^(p+1)) defect at h = 0.25: orders of magnitude above rounding for every real method of
+    // order <= 6 (measured: >= 1e9 ulps). Higher orders may legitimately come close to rounding
+    // (measured: M12 23 ulps, DP12 2 ulps). Complex methods are not asserted on: Gurkan's are
+    // symmetric-conjugate (reversed coefficients = conjugated ones), and with the imaginary parts
+    // dropped such a method retraces its step up to O(z^2), z = O(h^6) the imaginary part of one
+    // step (measured: AC1-6 2 ulps, AC1 150, BC2 3e4; Chambers, third order, 1e10).
+    EXPECT_GT(ulps, 1000 * kReversalUlps) << def.info.name
+                                          << " is declared non-symmetric but retraces its step: is it symmetric?";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Catalog, Symmetry, testing::ValuesIn(catalog_names()), test_name);
+
+TEST(SymmetryControl, NonSymmetricMethodsDoNotRetrace) {
+  // The task's named controls: Nystrom 4 and Albrecht 6, and M4 (a sum of symmetric products).
+  for (const char* name : {"N4", "A6", "M4"}) {
+    const MethodDef& def = find_in_catalog(name);
+    ASSERT_FALSE(def.info.symmetric) << name;
+    EXPECT_GT(reversal_defect_ulps(def, kStep), 1000 * kReversalUlps) << name;
+  }
+  // Symplectic Euler at h/2 (kick, drift) is not symmetric; followed by its adjoint (drift, kick)
+  // it is: Phi = A*_{h/2} o A_{h/2} is velocity Verlet.
+  auto make = [](const std::string& name, SplittingScheme<bigcomplex> (*build)()) {
+    MethodDef d{{.name = name, .family = "splitting", .order = 1, .source = "test", .description = name, .aliases = {}},
+                [build] { return MethodData{build()}; }};
+    nystrom::detail::finalize_info(d);
+    return d;
+  };
+  const MethodDef euler = make("euler", [] { return scheme({kick(big("1/2")), drift(big("1/2"))}); });
+  const MethodDef euler_adjoint = make("euler*euler", [] {
+    auto a = scheme({kick(big("1/2")), drift(big("1/2"))});
+    auto b = adjoint(a);
+    a.steps.insert(a.steps.end(), b.steps.begin(), b.steps.end());
+    return a;
+  });
+  EXPECT_GT(reversal_defect_ulps(euler, kStep), 1000 * kReversalUlps);
+  EXPECT_LT(reversal_defect_ulps(euler_adjoint, kStep), kReversalUlps);
+}
+
+// ---- (b) symplecticity --------------------------------------------------------------------------------
+
+namespace {
+
+using DualVec = std::array<Dual4, 2>;
+using Point = std::array<long double, 4>;  // (q0, q1, v0, v1)
+
+/// The Henon-Heiles force a = -grad V, V = (x^2 + y^2)/2 + x^2 y - y^3/3: not a central force.
+/// (On Kepler, Chin's A' is symplectic: its shifted force a(q + s a(q)) stays central, hence a gradient.)
+struct HenonHeilesForce {
+  template <class S>
+  void operator()(const std::array<S, 2>& q, std::array<S, 2>& a) const {
+    a[0] = -q[0] - S(2) * q[0] * q[1];
+    a[1] = -q[1] - q[0] * q[0] + q[1] * q[1];
+  }
+};
+
+/// One step of `def` from x0, in Dual4: the values and the 4x4 Jacobian.
+struct DualStep {
+  Point value{};
+  std::array<std::array<long double, 4>, 4> J{};  // J[i][k] = d out_i / d in_k, order (q0, q1, v0, v1)
+};
+
+template <class F = KeplerForce>
+DualStep dual_step(const MethodDef& def, long double h, const Point& x0, F force = {}) {
+  State<DualVec> s{{Dual4::variable(x0[0], 0), Dual4::variable(x0[1], 1)},
+                   {Dual4::variable(x0[2], 2), Dual4::variable(x0[3], 3)}};
+  auto integ = make_integrator<DualVec>(def, force);
+  integ.step(s, Dual4(h));
+  DualStep r;
+  const std::array<const Dual4*, 4> out{&s.q[0], &s.q[1], &s.v[0], &s.v[1]};
+  for (int i = 0; i < 4; ++i) {
+    r.value[i] = out[i]->v;
+    for (int k = 0; k < 4; ++k) r.J[i][k] = out[i]->d[k];
+  }
+  return r;
+}
+
+/// One step of `def` from a given state, in long double.
+template <class F = KeplerForce>
+Point real_step(const MethodDef& def, const Point& x, long double h, F force = {}) {
+  State<std::array<long double, 2>> s{{x[0], x[1]}, {x[2], x[3]}};
+  auto integ = make_integrator<std::array<long double, 2>>(def, force);
+  integ.step(s, h);
+  return {s.q[0], s.q[1], s.v[0], s.v[1]};
+}
+
+/// max |J^T Omega J - Omega| relative to max(1, |J|^2), in units of long double epsilon.
+double symplectic_defect_ulps(const std::array<std::array<long double, 4>, 4>& J) {
+  // Omega = [[0, I], [-I, 0]]: (Omega x)_a = x_{a+2}, (Omega x)_{a+2} = -x_a for a = 0, 1.
+  auto omega = [](int a, int b) -> long double { return (b == a + 2) ? 1.0L : (a == b + 2) ? -1.0L : 0.0L; };
+  long double defect = 0, jmax = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 4; ++k) jmax = std::max(jmax, std::abs(J[i][k]));
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b) {
+      long double m = 0;
+      for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 4; ++k) m += J[i][a] * omega(i, k) * J[k][b];
+      defect = std::max(defect, std::abs(m - omega(a, b)));
+    }
+  return static_cast<double>(defect / std::max(1.0L, jmax * jmax) / kEps);
+}
+
+constexpr double kSymplecticUlps = 300;
+
+Point kepler_start() {
+  const auto s0 = start_state();
+  return {s0.q[0], s0.q[1], s0.v[0], s0.v[1]};
+}
+/// Henon-Heiles at energy 0.12 (< 1/6, bounded), a generic point; h = 0.5 (the time scale is 2 pi).
+const Point kHenonStart{0.3L, -0.25L, 0.2L, 0.3L};
+constexpr long double kHenonStep = 0.5L;
+
+class Symplecticity : public testing::TestWithParam<std::string> {};
+
+}  // namespace
+
+TEST_P(Symplecticity, DeclaredSymplecticMethodsPreserveTheSymplecticForm) {
+  const MethodDef& def = find_in_catalog(GetParam());
+  if (def.info.adaptive) GTEST_SKIP() << def.info.name << " is adaptive (its own step-size controller)";
+  if (def.info.complex)
+    GTEST_SKIP() << def.info.name << " has complex coefficients: std::complex<Dual> is not a supported type, and "
+                 << "with the imaginary parts dropped the step is not symplectic";
+  const DualStep kep = dual_step(def, kStep, kepler_start());
+  const DualStep hh = dual_step(def, kHenonStep, kHenonStart, HenonHeilesForce{});
+  // The value part is plain long double arithmetic: bit-identical to the long double engine.
+  const auto plain_kep = real_step(def, kepler_start(), kStep);
+  const auto plain_hh = real_step(def, kHenonStart, kHenonStep, HenonHeilesForce{});
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(kep.value[i], plain_kep[i]) << def.info.name << " Kepler component " << i;
+    EXPECT_EQ(hh.value[i], plain_hh[i]) << def.info.name << " Henon-Heiles component " << i;
+  }
+  const double ulps_kep = symplectic_defect_ulps(kep.J), ulps_hh = symplectic_defect_ulps(hh.J);
+  std::cout << "[ symplect ] " << std::left << std::setw(16) << def.info.name << (def.info.symplectic ? " symplectic " : " -          ")
+            << " order " << std::setw(2) << def.info.order << "  defect Kepler " << std::setprecision(3) << std::setw(9)
+            << ulps_kep << " Henon-Heiles " << ulps_hh << " ulps" << std::endl;
+  if (def.info.symplectic) {
+    EXPECT_LT(ulps_kep, kSymplecticUlps) << def.info.name << " is declared symplectic but J^T Omega J != Omega (Kepler)";
+    EXPECT_LT(ulps_hh, kSymplecticUlps) << def.info.name << " is declared symplectic but J^T Omega J != Omega (Henon-Heiles)";
+  } else if (def.info.order <= 8) {
+    // Defects of high order in h, yet far above rounding up to order 8 (measured, the larger of the
+    // two problems: >= 4e11 ulps; M10 2e9, DP10 2e7). The high-order MPE methods are symplectic to
+    // order 2n+3 (Blanes, Casas and Ros; Chin sec. II) and come close to rounding (M16: 2e2 ulps).
+    EXPECT_GT(std::max(ulps_kep, ulps_hh), 1000 * kSymplecticUlps)
+        << def.info.name << " is declared non-symplectic but preserves the symplectic form";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Catalog, Symplecticity, testing::ValuesIn(catalog_names()), test_name);
+
+TEST(SymplecticityControl, NonSymplecticRknMethodsFail) {
+  for (const char* name : {"N4", "M4", "M4-RKN", "A6"}) {
+    const MethodDef& def = find_in_catalog(name);
+    ASSERT_FALSE(def.info.symplectic) << name;
+    EXPECT_GT(symplectic_defect_ulps(dual_step(def, kStep, kepler_start()).J), 1000 * kSymplecticUlps) << name;
+    EXPECT_GT(symplectic_defect_ulps(dual_step(def, kHenonStep, kHenonStart, HenonHeilesForce{}).J),
+              1000 * kSymplecticUlps)
+        << name;
+  }
+  // Chin's A' is not symplectic in general, but on Kepler it is (its shifted force stays central).
+  const MethodDef& aprime = find_in_catalog("Aprime");
+  EXPECT_LT(symplectic_defect_ulps(dual_step(aprime, kStep, kepler_start()).J), kSymplecticUlps);
+  EXPECT_GT(symplectic_defect_ulps(dual_step(aprime, kHenonStep, kHenonStart, HenonHeilesForce{}).J),
+            1000 * kSymplecticUlps);
+}
+
+TEST(SymplecticityControl, DualJacobianMatchesFiniteDifferences) {
+  // A broken derivative propagation would give J = I (which is symplectic!) or garbage: compare
+  // with central differences, and require J to be far from the identity.
+  const Point x0 = kepler_start();
+  for (const char* name : {"VV", "FR", "N4", "M6"}) {
+    const MethodDef& def = find_in_catalog(name);
+    const DualStep d = dual_step(def, kStep, x0);
+    long double off_identity = 0;
+    for (int k = 0; k < 4; ++k) {
+      const long double delta = 1e-6L;
+      auto xp = x0, xm = x0;
+      xp[k] += delta;
+      xm[k] -= delta;
+      const auto fp = real_step(def, xp, kStep), fm = real_step(def, xm, kStep);
+      for (int i = 0; i < 4; ++i) {
+        const long double fd = (fp[i] - fm[i]) / (2 * delta);
+        EXPECT_NEAR(static_cast<double>(d.J[i][k]), static_cast<double>(fd), 1e-8) << name << " J[" << i << "][" << k << "]";
+        off_identity = std::max(off_identity, std::abs(d.J[i][k] - (i == k ? 1.0L : 0.0L)));
+      }
+    }
+    EXPECT_GT(static_cast<double>(off_identity), 0.1) << name;
+  }
+}
