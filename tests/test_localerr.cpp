@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "nystrom/experiments/localerr.hpp"
+#include "nystrom/experiments/nbody_run.hpp"
 
 using namespace nystrom;
 
@@ -121,4 +122,25 @@ TEST(CpuTime, MeasuresEveryMethodAgainstTheLeapfrog) {
   for (const auto& row : r.rows) EXPECT_GT(row.ratio, 0);
   c.steps = 0;
   EXPECT_THROW(run_cputime(c), std::invalid_argument);
+}
+
+TEST(NBodyRun, MethodsAndGbsOnBothProblems) {
+  NBodySetup tb;
+  tb.problem = "twobody";
+  const double h = 2 * M_PI / 200;
+  const auto vv = run_nbody("VV", tb, h, 200);
+  const auto fr = run_nbody("FR", tb, h, 200);
+  const auto gbs = run_nbody("GBS", tb, h, 200, 1e-12);
+  EXPECT_LT(fr.position_error, vv.position_error);
+  EXPECT_LT(gbs.position_error, 1e-9);
+  EXPECT_LT(gbs.energy_error, 1e-10);
+  EXPECT_EQ(fr.force_evals, 3 * 200 + 0 * 1);  // position-first FR: 3 forces per step
+  NBodySetup nb;
+  nb.n = 30;
+  const auto a = run_nbody("VV", nb, 0.01, 10);
+  EXPECT_GT(a.position_error, 0);
+  EXPECT_LT(a.energy_error, 1e-3);
+  EXPECT_THROW(run_nbody("GBS", nb, 0.01, 10), std::invalid_argument);     // no tolerance
+  EXPECT_THROW(run_nbody("VV", nb, 0.01, 10, 1e-9), std::invalid_argument);  // tolerance for a fixed-step method
+  EXPECT_THROW(run_nbody("VV", nb, -0.01, 10), std::invalid_argument);
 }
