@@ -284,3 +284,53 @@ TEST(Precision, M16ReachesBelow1e28PerPeriodAtE09) {
   // Double stops at its round-off floor, many orders of magnitude above.
   EXPECT_GT(std::abs(run_kepler<double>(def, 0.9, 3000, 1).precession_per_period), 1e-20);
 }
+
+// DP12 (Dormand, El-Mikkawy & Prince; exact rationals), the other curve of Fig. 3 below 1e-28:
+// 11000 steps per period (187 000 force evaluations), method error about 2e-29.
+TEST(Precision, DP12ReachesBelow1e28PerPeriodAtE09) {
+  const auto def = resolve_method("DP12");
+  for_each_extended([&](auto tag, const std::string&) {
+    using T = typename decltype(tag)::type;
+    const auto r = run_kepler<T>(def, 0.9, 11000, 1);
+    EXPECT_LT(std::abs(r.precession_per_period), 1e-28);
+    EXPECT_LT(r.energy_error, 1e-27);
+  });
+}
+
+// Decimal coefficients are refined to the working precision: SS10's 26 published digits leave an
+// error floor of 1e-25 in quadruple precision that the refined set does not have.
+TEST(Precision, RefinedCoefficientsRemoveThePublishedDigitsFloor) {
+  const auto def = resolve_method("SS10");
+  ASSERT_EQ(def.info.published_digits, 26);
+  auto as_published = def;
+  as_published.info.published_digits = 0;  // pretend the 26 digits were exact: no refinement
+  const auto refined = run_kepler<float128>(def, 0.5, 2000, 1);
+  const auto published = run_kepler<float128>(as_published, 0.5, 2000, 1);
+  EXPECT_GT(published.position_error, 1e-26);  // the floor of the published digits
+  EXPECT_LT(refined.position_error, 1e-27);    // the method's own error, 1.4e-28
+  // In double the published digits are more than enough and are used as they are.
+  EXPECT_DOUBLE_EQ(run_kepler<double>(def, 0.5, 200, 1).position_error,
+                   run_kepler<double>(as_published, 0.5, 200, 1).position_error);
+}
+
+// Asking for a precision that a method's coefficients cannot reach, and cannot be refined to, is a
+// clear error (here: an RKN tableau printed with 16 digits).
+TEST(Precision, PrecisionBeyondUnrefinableCoefficientsIsAClearError) {
+  MethodDef n4 = resolve_method("N4");
+  n4.info.name = "N4-decimal";
+  n4.info.published_digits = 16;
+  n4.build = [] {
+    return MethodData{tableau({"0", "0.5", "1"}, {{}, {"0.125"}, {"0", "0.5"}}, {"0.1666666666666667", "0.3333333333333333", "0"},
+                              {"0.1666666666666667", "0.6666666666666667", "0.1666666666666667"})};
+  };
+  EXPECT_NO_THROW(run_kepler<double>(n4, 0.5, 100, 1));
+  for_each_extended([&](auto tag, const std::string& name) {
+    using T = typename decltype(tag)::type;
+    try {
+      run_kepler<T>(n4, 0.5, 100, 1);
+      ADD_FAILURE() << "no error";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("published with 16 digits, too few for " + name), std::string::npos) << e.what();
+    }
+  });
+}

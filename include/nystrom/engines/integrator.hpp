@@ -15,6 +15,7 @@
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/engines/splitting.hpp"
 #include "nystrom/methods/method.hpp"
+#include "nystrom/methods/refine.hpp"
 
 namespace nystrom {
 
@@ -79,16 +80,15 @@ class Integrator {
   Impl impl_;
 };
 
-/// Builds `def` for state type V at a reference precision matched to V's scalar type.
+/// Builds `def` for state type V at a reference precision matched to V's scalar type. Coefficients
+/// published as decimals with too few digits for that type are refined (methods/refine.hpp), or
+/// refused with std::invalid_argument when they cannot be.
 template <class V, class F>
 Integrator<V, F> make_integrator(const MethodDef& def, F force, EngineOptions opt = {}) {
   using T = real_t<typename V::value_type>;
-  const MethodData data = [&] {
-    BigPrecision guard(reference_bits(scalar_traits<T>::bits()));
-    return def.build();
-  }();
-  // The working values are created outside the guard: for run-time-precision types (mpfr_real) the
-  // reference precision must not leak into the working precision.
+  const MethodData data = method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
+  // The working values are created outside method_data_for's reference precision: for
+  // run-time-precision types (mpfr_real) it must not leak into the working precision.
   return Integrator<V, F>(data, std::move(force), opt);
 }
 
