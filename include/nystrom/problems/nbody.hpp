@@ -405,7 +405,7 @@ void nbody_tiles(std::size_t nb, int threads, Diag diag, Pair pair) {
   (void)threads;
   // Small systems run serially: a parallel region costs more than their force (and much more when the
   // machine is oversubscribed).
-  NYSTROM_OMP(omp parallel num_threads(threads) if (threads > 1 && nb >= 4)) {
+  NYSTROM_OMP(omp parallel num_threads(threads) if (threads > 1 && nb >= 8)) {
     NYSTROM_OMP(omp for schedule(static))
     for (long I = 0; I < static_cast<long>(nb); ++I) diag(static_cast<std::size_t>(I));
     for (std::size_t r = 0; r + 1 < P; ++r) {
