@@ -17,16 +17,19 @@
 //     (one refinement gains about three decades, so several points fit into the asymptotic range);
 //   * errors above 1e-3 are pre-asymptotic and not used. Errors below a floor end the refinement:
 //     100 N eps(T) for round-off (measured: about 0.2..1 N eps for the MPE methods) and, for methods
-//     with published decimal coefficients, 100 * 10^-digits (the method is only that consistent);
+//     with published decimal coefficients used as published, 100 * 10^-digits (the method is only that
+//     consistent);
 //   * refinement stops once the last three slopes agree within 0.05 and the error is below
 //     sqrt(eps(T)), or when the next refinement would fall under the floor;
 //   * the observed order is the slope log(e1/e2)/log(h1/h2) between the two smallest step sizes used;
 //     the range counts as asymptotic when the last two slopes agree within 0.15 (slopes that still
 //     jump, pre-asymptotic or round-off dominated, fail the test).
-// Precision: long double up to order 8. From order 10 on, long double has hardly any asymptotic range
+// Precision: long double up to order 6. From order 8 on, long double has little asymptotic range
 // (measured: M12..M16 at e = 0.3 drop from 1e-9 to the round-off level, 1e-16, within a factor 2.5 in
-// h, with slopes jumping between 4 and 21), so orders >= 10 run in a 113-bit binary type, WideReal,
-// as does any (real) method whose long double slopes do not settle.
+// h, with slopes jumping between 4 and 21; M8 and KL8 settle only just above it), so orders >= 8 run
+// in IEEE quadruple precision (nystrom::float128), as does any (real) method whose long double slopes
+// do not settle. Decimal coefficient tables are refined to the working precision where their digits do
+// not reach it (methods/refine.hpp); where they are used as published, their digits set a floor.
 // Acceptance: |observed - declared| < 0.35. Complex-coefficient methods (run with complex state,
 // imaginary parts dropped after every step) may show one order MORE than declared: for Gürkan's
 // fifth-order methods and Chambers' third-order one the leading error term is purely imaginary and
@@ -49,44 +52,7 @@
 #include <string>
 #include <vector>
 
-#include <boost/multiprecision/cpp_bin_float.hpp>
-
 #include "nystrom/nystrom.hpp"
-
-// ---- the wide type for high orders ------------------------------------------------------------------
-// A 113-bit binary floating type (the significand of IEEE quadruple) from Boost.Multiprecision, local
-// to this test: int32 exponent and no expression templates make it a type of its own, so it cannot
-// collide with the library's extended types. Once the library's float128 is available, WideReal can
-// become nystrom::float128 (and the scalar_traits below be removed).
-using WideReal = boost::multiprecision::number<
-    boost::multiprecision::cpp_bin_float<113, boost::multiprecision::digit_base_2, void, std::int32_t>,
-    boost::multiprecision::et_off>;
-
-namespace nystrom {
-template <>
-struct scalar_traits<WideReal> {
-  static std::string name() { return "bin113"; }
-  static long bits() { return 113; }
-  /// Exact conversion up to the final rounding: x = l0 + l1 + l2 in long doubles (192 bits), summed in 113 bits.
-  static WideReal from_mpfr(mpfr_srcptr x) {
-    if (!mpfr_number_p(x)) return WideReal(mpfr_get_ld(x, MPFR_RNDN));
-    mpfr_t r, c;
-    mpfr_init2(r, std::max<mpfr_prec_t>(mpfr_get_prec(x), 64));
-    mpfr_init2(c, 64);
-    mpfr_set(r, x, MPFR_RNDN);
-    WideReal out(0);
-    for (int k = 0; k < 3; ++k) {
-      const long double part = mpfr_get_ld(r, MPFR_RNDN);
-      out += WideReal(part);
-      mpfr_set_ld(c, part, MPFR_RNDN);
-      mpfr_sub(r, r, c, MPFR_RNDN);
-    }
-    mpfr_clear(c);
-    mpfr_clear(r);
-    return out;
-  }
-};
-}  // namespace nystrom
 
 using namespace nystrom;
 
@@ -172,7 +138,10 @@ OrderMeasurement measure_order(const MethodDef& def, int order_hint, const Order
   const T t_end = static_cast<T>(o.t_end);
   const double eps = as_double(epsilon_of<T>());
   const double deep = std::sqrt(eps);
-  const double coef_floor = def.info.published_digits > 0 ? o.floor_per_digit * std::pow(10.0, -def.info.published_digits) : 0;
+  // Published digits limit the method only where they are used as published (not refined).
+  const int digits = def.info.published_digits;
+  const bool as_published = digits > 0 && published_digits_suffice(digits, scalar_traits<T>::bits());
+  const double coef_floor = as_published ? o.floor_per_digit * std::pow(10.0, -digits) : 0;
   auto floor_at = [&](double n) { return std::max(o.floor_per_step * n * eps, coef_floor); };
   const double r = refinement_ratio(order_hint);
   OrderMeasurement m;
@@ -214,13 +183,13 @@ OrderMeasurement measure_order(const MethodDef& def, int order_hint, const Order
   return m;
 }
 
-/// The measurement used for catalog entries: long double up to order 8 (complex methods always),
-/// WideReal from order 10, and WideReal again when the long double slopes do not settle.
+/// The measurement used for catalog entries: long double up to order 6 (complex methods always),
+/// float128 from order 8, and float128 again when the long double slopes do not settle.
 OrderMeasurement measure_catalog_order(const MethodDef& def) {
   if (def.info.complex) return measure_order<long double>(def, def.info.order);
-  if (def.info.order >= 10) return measure_order<WideReal>(def, def.info.order);
+  if (def.info.order >= 8) return measure_order<float128>(def, def.info.order);
   auto m = measure_order<long double>(def, def.info.order);
-  if (!m.asymptotic) m = measure_order<WideReal>(def, def.info.order);
+  if (!m.asymptotic) m = measure_order<float128>(def, def.info.order);
   return m;
 }
 
