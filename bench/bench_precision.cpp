@@ -1,0 +1,142 @@
+// Cost per step of M8 (the {1,2,3,4} PV multi-product method, Chin eq 17; 10 forces per step) on
+// Kepler (Chin eqs 35-36, e = 0.9) in every precision, relative to double in the same run:
+//
+//   double, long-double, float128 (libquadmath), dd and qd (libqd), mpfr:113 and mpfr:256 (MPFR
+//   through Boost.Multiprecision)
+//
+// The engine is the same generic code in every case (make_integrator<std::array<T, 2>>); only the
+// scalar type differs. One benchmark iteration integrates a batch of kSteps steps from the apocentre
+// (h = 2 pi / kSteps, one period per batch), the state reset every iteration.
+//
+// Before benchmarking, every precision's final state after one period is checked against double's
+// (same method and step, so they must agree to double's rounding). After the run, a table gives the
+// CPU time per step (minimum over repetitions, robust on a shared machine) and the ratio to double.
+// Target (the issue): double-double at most 10x double per step.
+//
+//   bench_precision --benchmark_repetitions=5     (the default here: 5 repetitions, 0.2 s each)
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "nystrom/core/precision.hpp"
+#include "nystrom/engines/integrator.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/kepler.hpp"
+
+using namespace nystrom;
+
+namespace {
+
+constexpr double kEcc = 0.9;
+constexpr long kSteps = 2000;  // per batch: one period at h = 2 pi / 2000
+const char* const kMethod = "M8";
+
+const std::vector<std::string>& precisions() {
+  static const std::vector<std::string> p{"double", "long-double", "float128", "dd", "qd", "mpfr:113", "mpfr:256"};
+  return p;
+}
+
+/// One period of M8 in precision T from the apocentre; the final state in double.
+template <class T>
+std::array<double, 4> one_period() {
+  auto integ = make_integrator<std::array<T, 2>>(resolve_method(kMethod), KeplerForce{});
+  auto s = KeplerProblem<T>(T(kEcc)).initial_state();
+  integ.integrate(s, KeplerProblem<T>::period() / T(kSteps), kSteps);
+  return {as_double(s.q[0]), as_double(s.q[1]), as_double(s.v[0]), as_double(s.v[1])};
+}
+
+void bm_precision(benchmark::State& state, const std::string& precision) {
+  dispatch_precision(precision, [&](auto tag) {
+    using T = typename decltype(tag)::type;
+    auto integ = make_integrator<std::array<T, 2>>(resolve_method(kMethod), KeplerForce{});
+    const KeplerProblem<T> prob{T(kEcc)};
+    const auto s0 = prob.initial_state();
+    const T h = KeplerProblem<T>::period() / T(kSteps);
+    for (auto _ : state) {
+      auto s = s0;
+      integ.integrate(s, h, kSteps);
+      benchmark::DoNotOptimize(s);
+    }
+    state.SetItemsProcessed(state.iterations() * kSteps);
+    return 0;
+  });
+}
+
+bool check_agreement() {
+  const auto ref = one_period<double>();
+  bool ok = true;
+  for (const auto& p : precisions()) {
+    const auto x = dispatch_precision(p, [](auto tag) { return one_period<typename decltype(tag)::type>(); });
+    double diff = 0;
+    for (int k = 0; k < 4; ++k) diff = std::max(diff, std::abs(x[k] - ref[k]));
+    std::printf("check %-12s final state after one period vs double: max |difference| = %.2e\n", p.c_str(), diff);
+    if (!(diff < 1e-9)) {
+      std::fprintf(stderr, "error: %s does not reproduce double's one-period state\n", p.c_str());
+      ok = false;
+    }
+  }
+  return ok;
+}
+
+/// Console output as usual, plus the minimum CPU time per step of every benchmark for the summary.
+class SummaryReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const auto& r : runs) {
+      if (r.run_type != Run::RT_Iteration || r.error_occurred || r.iterations == 0) continue;
+      const double ns_per_step = r.cpu_accumulated_time * 1e9 / (static_cast<double>(r.iterations) * kSteps);
+      const std::string name = r.run_name.function_name;
+      auto it = best_.find(name);
+      if (it == best_.end() || ns_per_step < it->second) best_[name] = ns_per_step;
+    }
+  }
+  void summary() const {
+    std::printf("\n%s on Kepler e = %.1f, %ld steps per batch; minimum over repetitions of CPU time per step\n", kMethod,
+                kEcc, kSteps);
+    const auto base = best_.find("M8/double");
+    std::printf("%-12s %12s %10s\n", "precision", "ns/step", "/ double");
+    for (const auto& p : precisions()) {
+      const auto it = best_.find("M8/" + p);
+      if (it == best_.end()) continue;
+      if (base == best_.end()) {
+        std::printf("%-12s %12.1f %10s\n", p.c_str(), it->second, "-");
+      } else {
+        const double ratio = it->second / base->second;
+        std::printf("%-12s %12.1f %10.2f%s\n", p.c_str(), it->second, ratio,
+                    p == "dd" && ratio > 10 ? "  (target for dd: <= 10)" : "");
+      }
+    }
+  }
+
+ private:
+  std::map<std::string, double> best_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (const auto& p : precisions())
+    benchmark::RegisterBenchmark(("M8/" + p).c_str(), [p](benchmark::State& s) { bm_precision(s, p); })->MinTime(0.2);
+  // Five repetitions unless the command line says otherwise.
+  std::vector<char*> args(argv, argv + argc);
+  std::string reps = "--benchmark_repetitions=5";
+  if (std::none_of(args.begin() + 1, args.end(),
+                   [](const char* a) { return std::string(a).rfind("--benchmark_repetitions", 0) == 0; }))
+    args.push_back(reps.data());
+  int n = static_cast<int>(args.size());
+  benchmark::Initialize(&n, args.data());
+  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
+  if (!check_agreement()) return 1;
+  SummaryReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  reporter.summary();
+  benchmark::Shutdown();
+  return 0;
+}
