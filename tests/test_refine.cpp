@@ -133,22 +133,27 @@ TEST(Refine, ReachesVeryHighPrecision) {
   EXPECT_LE(max_change(r), bigfloat("1e-24"));
 }
 
-// The same refined set whatever precision it was computed at (the solution nearest the published
-// digits is well defined): 256- and 512-bit refinements agree to 256 bits.
-TEST(Refine, SolutionIsIndependentOfThePrecision) {
-  const auto def = resolve_method("KL6");  // one free parameter: the minimum-norm choice matters
-  std::vector<bigfloat> at256, at512;
-  {
-    BigPrecision guard(256);
-    at256 = refine_splitting(std::get<SplittingScheme<bigcomplex>>(def.build()), 6, "KL6").refined;
+// The same refined set whatever precision it was computed at, and whichever way it is reached (the
+// solution in the affine space through the published point spanned by the selected gradients is
+// well defined): chord steps only, Newton steps only, or the automatic mix.
+TEST(Refine, SolutionIsIndependentOfPrecisionAndStrategy) {
+  for (const std::string name : {"KL6", "AC1"}) {  // KL6 has a free parameter; AC1 is complex
+    SCOPED_TRACE(name);
+    const auto def = resolve_method(name);
+    auto refined_at = [&](unsigned bits, RefineStrategy how) {
+      BigPrecision guard(bits);
+      return refine_splitting(std::get<SplittingScheme<bigcomplex>>(def.build()), def.info.order, name, how).refined;
+    };
+    const auto a = refined_at(256, RefineStrategy::automatic);
+    const auto chord = refined_at(1000, RefineStrategy::chord);
+    const auto newton = refined_at(1000, RefineStrategy::newton);
+    BigPrecision guard(1000);
+    ASSERT_EQ(a.size(), chord.size());
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      EXPECT_LE(abs(a[k] - chord[k]), ldexp(bigfloat(1), 16 - 256)) << k;
+      EXPECT_LE(abs(newton[k] - chord[k]), ldexp(bigfloat(1), 16 - 1000)) << k;
+    }
   }
-  {
-    BigPrecision guard(512);
-    at512 = refine_splitting(std::get<SplittingScheme<bigcomplex>>(def.build()), 6, "KL6").refined;
-  }
-  BigPrecision guard(512);
-  ASSERT_EQ(at256.size(), at512.size());
-  for (std::size_t k = 0; k < at256.size(); ++k) EXPECT_LE(abs(at256[k] - at512[k]), ldexp(bigfloat(1), 16 - 256)) << k;
 }
 
 // method_data_for: published tables where their digits suffice, refined ones (cached) beyond.

@@ -19,12 +19,13 @@
 // family of solutions, e.g. Kahan-Li, Sofroniou-Spaletta, Blanes-Moan, Gürkan's optimised ones): a
 // maximal set of independent equations is chosen once at the published point (greedy pivoting, with
 // a threshold of sqrt(|F|) relative to the largest row: directions that the published digits cannot
-// resolve are not equations), and each step is the minimum-norm correction with the Jacobian of the
-// published point (a fresh one only if convergence slows). The result is the solution in the affine
-// space through the published point spanned by those Jacobian rows, i.e. the solution nearest to the
-// published table to first order, whatever the working precision; it differs from the table by about
-// its rounding, and satisfies every condition (including those not selected) to the reference
-// precision, which is checked before it is used.
+// resolve are not equations). The result is the solution in the affine space through the published
+// point spanned by those equations' gradients there, i.e. the solution nearest to the published table
+// to first order, the same whatever the working precision. It is reached by chord steps (minimum-norm
+// corrections with the Jacobian of the published point; each gains about as many digits as the table
+// has) and, when many digits are still missing, Newton steps within that affine space (quadratic).
+// It differs from the table by about the table's rounding and satisfies every condition (including
+// those not selected) to the reference precision, which is checked before it is used.
 //
 // Methods that are neither exact nor refinable (e.g. an RKN tableau printed in decimals), asked for in
 // a precision their digits cannot reach, are refused with std::invalid_argument.
@@ -400,11 +401,40 @@ class MinNormSolver {
     return x;
   }
 
+  /// The orthonormal basis of the row space of A (r vectors of length n).
+  const std::vector<std::vector<bigfloat>>& basis() const { return q_; }
+
  private:
   std::size_t n_ = 0;
   std::vector<std::vector<bigfloat>> q_;
   std::vector<std::vector<bigfloat>> R_;
 };
+
+/// Solves the square system M x = b by Gaussian elimination with partial pivoting.
+inline std::vector<bigfloat> solve_square(std::vector<std::vector<bigfloat>> m, std::vector<bigfloat> b) {
+  const std::size_t r = b.size();
+  for (std::size_t c = 0; c < r; ++c) {
+    std::size_t piv = c;
+    for (std::size_t i = c + 1; i < r; ++i)
+      if (abs(m[i][c]) > abs(m[piv][c])) piv = i;
+    if (m[piv][c] == 0) throw std::runtime_error("singular Newton matrix");
+    std::swap(m[piv], m[c]);
+    std::swap(b[piv], b[c]);
+    for (std::size_t i = c + 1; i < r; ++i) {
+      const bigfloat f = m[i][c] / m[c][c];
+      if (f == 0) continue;
+      for (std::size_t k = c; k < r; ++k) m[i][k] -= f * m[c][k];
+      b[i] -= f * b[c];
+    }
+  }
+  std::vector<bigfloat> x(r, bigfloat(0));
+  for (std::size_t c = r; c-- > 0;) {
+    bigfloat s = b[c];
+    for (std::size_t k = c + 1; k < r; ++k) s -= m[c][k] * x[k];
+    x[c] = s / m[c][c];
+  }
+  return x;
+}
 
 }  // namespace refine_detail
 
@@ -424,10 +454,15 @@ struct Refinement {
 
 inline std::string short_str(const bigfloat& x) { return x.str(3, std::ios_base::scientific); }
 
+/// How refine_splitting reaches its solution (the same point in every case): chord steps, Newton
+/// steps, or chord first and Newton when that is cheaper (the default).
+enum class RefineStrategy { automatic, chord, newton };
+
 /// Refines a splitting scheme of order `order` at the current MPFR default precision (hold a
 /// BigPrecision). Throws std::invalid_argument if the published table is not close to a solution or
 /// Newton's method does not reach the precision.
-inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published, int order, const std::string& name) {
+inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published, int order, const std::string& name,
+                                   RefineStrategy strategy = RefineStrategy::automatic) {
   using namespace refine_detail;
   const long prec = static_cast<long>(boost::multiprecision::detail::digits10_2_2(bigfloat::default_precision()));
   const std::string what = "cannot refine the coefficients of " + name + " to " + std::to_string(prec) + " bits: ";
@@ -458,36 +493,72 @@ inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published,
   const std::vector<std::size_t> rows = independent_rows(jac, rel_tol);
   out.independent = rows.size();
   const bigfloat target = ldexp(bigfloat(1), static_cast<int>(32 - prec));
-  // Newton's method with the Jacobian kept while it converges fast (the published digits start it
-  // within 1e-15 or closer, so a step with the first Jacobian gains as much as a fresh one would).
-  auto factor = [&] {
+  // The solution sought: x = x0 + Q^T z on the solution manifold, Q an orthonormal basis of the rows
+  // of the selected equations' Jacobian J0 at the published point x0 (the nearest solution to first
+  // order; a definition independent of the working precision). Two ways to the same point:
+  //   * chord steps  dx = -J0^+ F(x)  (one Jacobian for all; each step gains about as many digits as
+  //     the table has, as J(x) - J0 = O(|x - x0|) = O(10^-digits));
+  //   * Newton steps in z: (J(x) Q^T) dz = -F(x), quadratic, each with a fresh Jacobian,
+  // chord while few steps remain, Newton when many digits are still missing (very high precision).
+  std::optional<MinNormSolver> chord;
+  try {
     std::vector<std::vector<bigfloat>> a;
     for (const std::size_t r : rows) a.push_back(jac[r]);
-    try {
-      return MinNormSolver(a);
-    } catch (const std::runtime_error&) {
-      throw std::invalid_argument(what + "the order conditions became dependent during Newton's method");
-    }
+    if (!rows.empty()) chord.emplace(a);
+  } catch (const std::runtime_error&) {
+    throw std::invalid_argument(what + "the selected order conditions are dependent");
+  }
+  auto selected_max = [&] {
+    bigfloat m(0);
+    for (const std::size_t r : rows) m = std::max(m, bigfloat(boost::multiprecision::abs(f[r])));
+    return m;
   };
-  std::optional<MinNormSolver> solver;
-  if (!rows.empty()) solver.emplace(factor());
-  bigfloat last = max_abs(f);
-  for (int it = 1; it <= 60 && solver; ++it) {
+  bool newton = strategy == RefineStrategy::newton;
+  bigfloat last = selected_max();
+  const int max_iterations = 50 + static_cast<int>(prec / 8);  // chord steps gain >= 8 bits, or Newton takes over
+  for (int it = 1; it <= max_iterations && chord; ++it) {
     std::vector<bigfloat> b;
     for (const std::size_t r : rows) b.push_back(-f[r]);
-    const std::vector<bigfloat> dx = solver->solve(b);
+    std::vector<bigfloat> dx;
+    if (!newton) {
+      dx = chord->solve(b);
+    } else {
+      const auto& q = chord->basis();
+      std::vector<std::vector<bigfloat>> m(rows.size(), std::vector<bigfloat>(q.size(), bigfloat(0)));
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        for (std::size_t j = 0; j < q.size(); ++j) m[i][j] = dot(jac[rows[i]], q[j]);
+      std::vector<bigfloat> dz;
+      try {
+        dz = solve_square(std::move(m), std::move(b));
+      } catch (const std::runtime_error&) {
+        throw std::invalid_argument(what + "the Newton matrix became singular");
+      }
+      dx.assign(x.size(), bigfloat(0));
+      for (std::size_t j = 0; j < q.size(); ++j)
+        for (std::size_t k = 0; k < x.size(); ++k) dx[k] += dz[j] * q[j][k];
+    }
     for (std::size_t k = 0; k < x.size(); ++k) x[k] += dx[k];
     out.iterations = it;
     bigfloat size(1);
     for (const auto& v : x) size = std::max(size, bigfloat(boost::multiprecision::abs(v)));
     const bool tiny_step = max_abs(dx) <= ldexp(size, static_cast<int>(8 - prec));
-    evaluate(x, false);
-    const bigfloat now = max_abs(f);
-    if (tiny_step) break;                        // converged to rounding
-    if (now <= target && !(now < last)) break;   // no further progress
-    if (!(now < last * bigfloat("0.1"))) {       // slow: a fresh Jacobian (a full Newton step)
-      evaluate(x, true);
-      solver.emplace(factor());
+    evaluate(x, newton);
+    const bigfloat now = selected_max();
+    if (tiny_step || now == 0) break;                    // converged to rounding
+    if (max_abs(f) <= target && !(now < last)) break;    // no further progress
+    if (!newton && strategy == RefineStrategy::automatic) {
+      // Cost model, in residual evaluations: the chord needs missing / per_step more of them; Newton
+      // doubles the correct bits per step, each step a Jacobian (measured: worth about 2 (parameters
+      // + 1) evaluations).
+      const double per_step = static_cast<double>(log2(last / now));
+      const double have = std::max(1.0, -static_cast<double>(log2(now)));
+      const double want = static_cast<double>(-log2(target));
+      const double chord_cost = (want - have) / std::max(per_step, 1e-3);
+      const double newton_cost = 2.0 * static_cast<double>(x.size() + 1) * std::ceil(std::log2(std::max(2.0, want / have)));
+      if (!(per_step > 1) || newton_cost < chord_cost) {
+        newton = true;
+        evaluate(x, true);
+      }
     }
     last = now;
   }
