@@ -1,0 +1,26 @@
+# Installs the built project into a scratch prefix, then configures, builds and runs examples/ against it
+# with find_package(nystrom CONFIG), as a downstream project would.
+file(REMOVE_RECURSE ${WORK_DIR})
+execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix
+                RESULT_VARIABLE rc OUTPUT_QUIET)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "install failed")
+endif()
+if(NOT EXISTS ${WORK_DIR}/prefix/include/nystrom/nystrom.hpp)
+  message(FATAL_ERROR "headers were not installed")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples -B ${WORK_DIR}/build
+                        -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "configuring the examples against the installed package failed")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/build RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "building the examples against the installed package failed")
+endif()
+execute_process(COMMAND ${WORK_DIR}/build/kepler_orders RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "M16")
+  message(FATAL_ERROR "the example did not run: ${out}")
+endif()
+message(STATUS "installed package works:\n${out}")
