@@ -18,7 +18,15 @@ struct Options {
 
 nystrom::cli::Registrar reg("run", "Integrate one problem with one method and report its errors", [](CLI::App& app) {
   auto o = std::make_shared<Options>();
-  app.add_option("--problem", o->req.problem, "Problem: kepler (Chin eqs 35-36) or harmonic")->capture_default_str();
+  app.add_option("--problem", o->req.problem,
+                 "Problem: kepler (Chin eqs 35-36), harmonic, twobody (two equal masses), nbody (Plummer sphere)")
+      ->capture_default_str();
+  app.add_option("--n", o->req.n, "nbody: number of particles of the Plummer sphere")->capture_default_str();
+  app.add_option("--seed", o->req.seed, "nbody: seed of the Plummer sample")->capture_default_str();
+  app.add_option("--ic", o->req.ic_file, "nbody: particle file (m x y z vx vy vz per line)");
+  app.add_option("--eps2", o->req.eps2, "nbody: softening squared (default (1/N)^2; twobody 0)");
+  app.add_option("--h", o->req.h, "nbody: step size")->capture_default_str();
+  app.add_option("--steps", o->req.steps, "nbody: number of steps")->capture_default_str();
   app.add_option("--ecc", o->req.ecc, "Kepler eccentricity, 0 <= e < 1")->capture_default_str();
   app.add_option("--method", o->method, "Method name or spec (see `nystrom methods`)")->required();
   app.add_option("--steps-per-period", o->req.steps_per_period, "Steps per orbital period")->capture_default_str();
@@ -28,7 +36,7 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
   app.add_flag("--json", o->json, "Print one JSON object");
   return [o]() {
-    const auto def = nystrom::resolve_method(o->method);
+    const auto def = nystrom::cli::resolve_run_method(o->method);
     const auto r = nystrom::cli::run_case(o->req, def);
     if (o->json) {
       std::cout << r.to_json().dump(2) << "\n";
@@ -40,6 +48,7 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
     fmt::print("steps             {} (h = {:.6g})\n", r.steps, r.h);
     fmt::print("force evaluations {}\n", r.force_evals);
     if (r.problem == "kepler") fmt::print("precession/period {:+.6e} rad\n", r.precession_per_period);
+    if (r.problem == "nbody") fmt::print("(position error against a GBS reference run at tolerance 1e-13)\n");
     fmt::print("energy error      {:.6e} (relative)\n", r.energy_error);
     fmt::print("position error    {:.6e}\n", r.position_error);
     fmt::print("time              {:.6f} s\n", r.seconds);

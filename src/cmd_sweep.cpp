@@ -3,6 +3,7 @@
 //
 // N is the number of force evaluations spent on one orbital period: a method with f forces per step
 // runs round(N / f) steps per period (h = 2 pi f / N). The error is the LRL precession per period.
+#include <cmath>
 #include <iostream>
 #include <memory>
 
@@ -19,6 +20,7 @@ struct Options {
   std::string methods = "FR,N4,M4,M6,A6";
   std::string evals = "1e3:1e6:20";
   std::string tols;
+  double t_end = 1.0;
   std::string csv, plot, metric = "precession";
   bool json = false;
 };
@@ -27,7 +29,14 @@ nystrom::cli::Registrar reg("sweep", "Error against force evaluations for severa
                             [](CLI::App& app) {
                               auto o = std::make_shared<Options>();
                               o->base.periods = 1;
-                              app.add_option("--problem", o->base.problem, "Problem (kepler, harmonic)")->capture_default_str();
+                              app.add_option("--problem", o->base.problem, "Problem (kepler, harmonic, twobody, nbody)")
+                                  ->capture_default_str();
+                              app.add_option("--n", o->base.n, "nbody: particles")->capture_default_str();
+                              app.add_option("--seed", o->base.seed, "nbody: Plummer seed")->capture_default_str();
+                              app.add_option("--ic", o->base.ic_file, "nbody: particle file");
+                              app.add_option("--eps2", o->base.eps2, "nbody: softening squared");
+                              app.add_option("--t-end", o->t_end, "nbody: time span of each run (N counts forces over it)")
+                                  ->capture_default_str();
                               app.add_option("--ecc", o->base.ecc, "Kepler eccentricity")->capture_default_str();
                               app.add_option("--methods", o->methods, "Comma-separated methods")->capture_default_str();
                               app.add_option("--force-evals", o->evals, "FROM:TO:COUNT force evaluations per period (log-spaced)")
@@ -44,6 +53,8 @@ nystrom::cli::Registrar reg("sweep", "Error against force evaluations for severa
                                 using namespace nystrom::cli;
                                 SweepRequest req;
                                 req.base = o->base;
+                                if (!(o->t_end > 0) || !std::isfinite(o->t_end)) throw UsageError("--t-end must be positive");
+                                req.t_end = o->t_end;
                                 req.methods = split_list(o->methods, "--methods");
                                 req.force_evals = parse_log_range(o->evals, "--force-evals");
                                 if (!o->tols.empty()) req.tols = parse_log_range(o->tols, "--tols", true);

@@ -8,6 +8,8 @@
 #include "nystrom/core/precision.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/experiments/kepler.hpp"
+#include "nystrom/experiments/nbody_run.hpp"
+#include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
 
 namespace nystrom::cli {
@@ -70,25 +72,89 @@ nlohmann::json RunReport::to_json() const {
 }
 
 const std::vector<std::string>& problem_names() {
-  static const std::vector<std::string> names{"kepler", "harmonic"};
+  static const std::vector<std::string> names{"kepler", "harmonic", "twobody", "nbody"};
   return names;
 }
+
+MethodDef gbs_method() {
+  MethodDef d;
+  d.info.name = "GBS";
+  d.info.family = "extrapolation";
+  d.info.adaptive = true;
+  d.info.source = "Gragg (1965); Bulirsch & Stoer (1966); Hairer, Norsett & Wanner I, sec. II.9/II.14 (ODEX2)";
+  d.info.description = "Gragg-Bulirsch-Stoer extrapolation, adaptive step and order";
+  d.build = [] () -> MethodData { throw std::invalid_argument("GBS has no coefficient table"); };
+  return d;
+}
+
+MethodDef resolve_run_method(const std::string& spec) {
+  if (spec == "GBS" || spec == "gbs") return gbs_method();
+  return resolve_method(spec);
+}
+
+namespace {
+
+RunReport run_nbody_case(const RunRequest& req, const MethodDef& def) {
+  if (req.precision != "double") throw UsageError("--problem " + req.problem + " runs in double precision only");
+  if (req.keep_complex) throw UsageError("--keep-complex is not available for --problem " + req.problem);
+  NBodySetup setup;
+  setup.problem = req.problem;
+  if (req.n <= 0 || req.n > 1000000) throw UsageError("--n must be between 1 and 1000000");
+  setup.n = static_cast<std::size_t>(req.n);
+  setup.seed = req.seed;
+  setup.ic_file = req.ic_file;
+  setup.ecc = req.ecc;
+  setup.eps2 = req.eps2;
+  double h = req.h;
+  long steps = req.steps;
+  if (req.problem == "twobody") {  // whole periods of the relative orbit, as for kepler
+    if (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1) throw UsageError("--ecc must satisfy 0 <= e < 1");
+    h = 2 * std::acos(-1.0) / static_cast<double>(req.steps_per_period);
+    steps = req.steps_per_period * req.periods;
+  }
+  const bool gbs = def.info.family == "extrapolation";
+  const auto r = run_nbody(gbs ? "GBS" : def.info.name, setup, h, steps, gbs ? req.tol : 0.0);
+  RunReport out;
+  out.ecc = req.problem == "twobody" ? req.ecc : RunReport::nan;
+  out.steps = r.steps;
+  out.force_evals = r.force_evals;
+  out.h = r.h;
+  out.energy_error = r.energy_error;
+  out.position_error = r.position_error;
+  out.seconds = r.seconds;
+  return out;
+}
+
+}  // namespace
 
 RunReport run_case(const RunRequest& req, const MethodDef& def) {
   if (req.steps_per_period <= 0) throw UsageError("--steps-per-period must be a positive integer");
   if (req.periods <= 0) throw UsageError("--periods must be a positive integer");
+  if (req.steps <= 0) throw UsageError("--steps must be a positive integer");
+  if (!(req.h > 0) || !std::isfinite(req.h)) throw UsageError("--h must be positive and finite");
   if (req.steps_per_period > 1'000'000'000L / req.periods)
     throw UsageError("too many steps requested (steps-per-period x periods must be at most 1e9)");
   if (def.info.adaptive && !(req.tol > 0 && std::isfinite(req.tol)))
     throw UsageError("method '" + def.info.name + "' is adaptive: give a positive --tol");
   if (!def.info.adaptive && req.tol != 0)
     throw UsageError("--tol applies to adaptive methods only; '" + def.info.name + "' runs with fixed steps");
+  if (req.problem == "nbody" || req.problem == "twobody") {
+    RunReport r = run_nbody_case(req, def);
+    r.method = def.info.name;
+    r.family = def.info.family;
+    r.order = def.info.order;
+    r.problem = req.problem;
+    r.precision = req.precision;
+    return r;
+  }
+  const bool gbs = def.info.family == "extrapolation";
   RunReport r = dispatch_precision(req.precision, [&](auto tag) -> RunReport {
     using T = typename decltype(tag)::type;
     if (req.problem == "kepler") {
       if (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1)
         throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
-      const auto k = def.info.adaptive
+      const auto k = gbs ? run_kepler_gbs<T>(req.ecc, req.tol, req.periods)
+                     : def.info.adaptive
                          ? run_kepler_adaptive<T>(def, req.ecc, req.tol, req.periods)
                          : run_kepler<T>(def, req.ecc, req.steps_per_period, req.periods, EngineOptions{req.keep_complex});
       RunReport out;

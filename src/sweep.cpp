@@ -15,7 +15,7 @@ std::vector<SweepRow> run_sweep(const SweepRequest& req) {
   if (req.methods.empty()) throw UsageError("no methods given");
   if (req.force_evals.empty()) throw UsageError("no force-evaluation counts given");
   std::vector<MethodDef> defs;
-  for (const auto& m : req.methods) defs.push_back(resolve_method(m));  // fail early on unknown names
+  for (const auto& m : req.methods) defs.push_back(resolve_run_method(m));  // fail early on unknown names
   long total = 0;
   for (const auto& def : defs) {
     if (def.info.adaptive && req.tols.empty())
@@ -30,10 +30,15 @@ std::vector<SweepRow> run_sweep(const SweepRequest& req) {
       for (double tol : req.tols) {
         RunRequest r = req.base;
         r.tol = tol;
+        if (r.problem == "nbody") {
+          r.h = req.t_end;
+          r.steps = 1;
+        }
         progress.tick(++done);
         SweepRow row;
         row.report = run_case(r, def);
-        row.force_evals_per_period = static_cast<double>(row.report.force_evals) / static_cast<double>(r.periods);
+        row.force_evals_per_period =
+            static_cast<double>(row.report.force_evals) / static_cast<double>(r.problem == "nbody" ? 1 : r.periods);
         rows.push_back(row);
       }
       continue;
@@ -42,13 +47,21 @@ std::vector<SweepRow> run_sweep(const SweepRequest& req) {
     long last_steps = -1;
     for (double N : req.force_evals) {
       RunRequest r = req.base;
-      r.steps_per_period = std::max(1L, std::lround(N / f));
+      const long steps = std::max(1L, std::lround(N / f));
       progress.tick(++done);
-      if (r.steps_per_period == last_steps) continue;  // same run as the previous N
-      last_steps = r.steps_per_period;
+      if (steps == last_steps) continue;  // same run as the previous N
+      last_steps = steps;
+      const bool span = r.problem == "nbody";  // no period: N counts the forces over t_end
+      if (span) {
+        r.steps = steps;
+        r.h = req.t_end / static_cast<double>(steps);
+      } else {
+        r.steps_per_period = steps;
+      }
       SweepRow row;
       row.report = run_case(r, def);
-      row.force_evals_per_period = static_cast<double>(row.report.force_evals) / static_cast<double>(r.periods);
+      row.force_evals_per_period =
+          static_cast<double>(row.report.force_evals) / static_cast<double>(span ? 1 : r.periods);
       rows.push_back(row);
     }
   }

@@ -18,6 +18,7 @@ struct SweepRequest {
   std::vector<std::string> methods;
   std::vector<double> force_evals;     // target force evaluations per period
   std::vector<double> tols;            // adaptive methods run once per tolerance instead
+  double t_end = 1.0;                  // nbody: the time span of every run (N counts forces over it)
 };
 
 /// Runs every (method, N); N is turned into steps per period as round(N / forces_per_step).

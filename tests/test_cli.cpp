@@ -124,6 +124,27 @@ TEST(Cli, AdaptiveMethodMeetsItsTolerance) {
   EXPECT_EQ(j["force_evals"].get<long>() % 17, 2);  // 17 per attempted step + 2 for the starting step
 }
 
+TEST(Cli, NBodyTwoBodyAndGbsRuns) {
+  // Two equal masses at e = 0.2 with Gurkan's BR1: fifth order, so 4x the steps cut the error ~1000x.
+  auto err = [&](int n) {
+    const auto r = run("run --problem twobody --ecc 0.2 --method BR1 --steps-per-period " + std::to_string(n) +
+                       " --periods 2 --json");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return nlohmann::json::parse(r.out)["position_error"].get<double>();
+  };
+  const double ratio = err(100) / err(400);
+  EXPECT_GT(ratio, 400.0);
+  EXPECT_LT(ratio, 6000.0);
+  const auto nb = run("run --problem nbody --n 64 --method RKNb6 --h 0.01 --steps 20 --json");
+  ASSERT_EQ(nb.code, 0) << nb.err;
+  const auto j = nlohmann::json::parse(nb.out);
+  EXPECT_EQ(j["force_evals"], 20 * 6 + 1);
+  EXPECT_LT(j["energy_error"].get<double>(), 1e-3);
+  const auto g = run("run --problem kepler --ecc 0.5 --method GBS --tol 1e-12 --json");
+  ASSERT_EQ(g.code, 0) << g.err;
+  EXPECT_LT(nlohmann::json::parse(g.out)["position_error"].get<double>(), 1e-9);
+}
+
 TEST(Cli, SweepWritesCsvAndPlot) {
   const auto dir = temp_dir();
   const auto csv = dir / "s.csv", png = dir / "s.png";
@@ -173,6 +194,13 @@ TEST(Cli, BadInputIsOneClearLineAndExitCode2) {
       "run --method DP12-adaptive",                              // adaptive without --tol
       "run --method DP12-adaptive --tol -1",                     //
       "run --method M4 --tol 1e-3",                              // --tol on a fixed-step method
+      "run --method GBS",                                        // GBS without --tol
+      "run --problem nbody --method LF --precision float128",    // N-body is double only
+      "run --problem nbody --method LF --n 0",                   //
+      "run --problem nbody --method LF --h -0.1",                //
+      "run --problem nbody --method LF --steps 0",               //
+      "run --problem nbody --method LF --ic /nonexistent.csv",   // missing particle file
+      "run --problem twobody --method LF --ecc 1.5",             //
       "coeffs mpe --seq 1,2,x",                                  //
       "coeffs mpe",                                              // nothing asked
       "sweep --methods FR --force-evals 1e3:1e2:5",              // decreasing range

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "nystrom/engines/adaptive_rkn.hpp"
+#include "nystrom/engines/gbs.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
@@ -72,6 +73,35 @@ KeplerRunResult run_kepler_adaptive(const MethodDef& def, double ecc, double tol
   r.steps = st.accepted;
   r.force_evals = st.force_evals;
   r.h = as_double(t_end / T(st.accepted > 0 ? st.accepted : 1));  // mean accepted step
+  r.seconds = std::chrono::duration<double>(t1 - t0).count();
+  detail::kepler_diagnostics(r, prob, s0, s, t_end, periods);
+  return r;
+}
+
+/// Integrates `periods` orbits with the Gragg-Bulirsch-Stoer extrapolation integrator at tolerance `tol`
+/// (relative and absolute), in real type T. `steps` counts accepted steps.
+template <class T>
+KeplerRunResult run_kepler_gbs(double ecc, double tol, long periods) {
+  if (periods <= 0) throw std::invalid_argument("number of periods must be positive");
+  if (!(tol > 0) || !std::isfinite(tol)) throw std::invalid_argument("GBS needs a positive, finite tolerance");
+  const KeplerProblem<T> prob(static_cast<T>(ecc));
+  GbsOptions opt;
+  opt.rtol = opt.atol = tol;
+  GbsIntegrator<std::array<T, 2>, KeplerForce> integ(KeplerForce{}, opt);
+  const auto s0 = prob.initial_state();
+  auto s = s0;
+  const T t_end = KeplerProblem<T>::period() * T(periods);
+  const auto t0 = std::chrono::steady_clock::now();
+  integ.integrate_to(s, t_end);
+  const auto t1 = std::chrono::steady_clock::now();
+  KeplerRunResult r;
+  r.method = "GBS";
+  r.order = 0;
+  r.precision = scalar_traits<T>::name();
+  r.ecc = ecc;
+  r.steps = integ.steps();
+  r.force_evals = integ.force_evals();
+  r.h = as_double(t_end / T(r.steps > 0 ? r.steps : 1));
   r.seconds = std::chrono::duration<double>(t1 - t0).count();
   detail::kepler_diagnostics(r, prob, s0, s, t_end, periods);
   return r;
