@@ -10,18 +10,38 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "nystrom/core/scalar.hpp"
 
 namespace nystrom {
 
+/// Compensated (Kahan/Knuth two-sum) summation of the position and velocity updates.
+/// automatic: on for float and double (as in Hairer's GNI codes), off for wider types.
+enum class Compensation : unsigned char { automatic, on, off };
+
 /// Options shared by all engines.
 struct EngineOptions {
   /// Complex-coefficient methods: keep the complexified state instead of dropping the
   /// imaginary parts after every step (the default drops them, as in the Gürkan paper).
   bool keep_complex = false;
+  /// Compensated summation of the updates q += dq, v += dv (carries the rounding error of each
+  /// addition to the next one; see Compensator below).
+  Compensation compensated = Compensation::automatic;
+  /// MPE only, for measurements: combine the products naively as sum c_i T_i instead of
+  /// T_ref + sum c_i (T_i - T_ref).
+  bool mpe_naive_combination = false;
 };
+
+/// Whether compensated summation is used for scalar type S under option c.
+template <class S>
+constexpr bool use_compensation(Compensation c) {
+  using T = real_t<S>;
+  if (c == Compensation::on) return true;
+  if (c == Compensation::off) return false;
+  return std::is_same_v<T, float> || std::is_same_v<T, double>;
+}
 
 template <class V>
 struct State {
@@ -83,6 +103,67 @@ void validate_state(const State<V>& s) {
                                 std::to_string(s.v.size()) + " velocities");
   if (!all_finite(s.q) || !all_finite(s.v)) throw std::invalid_argument("state contains NaN or infinite values");
 }
+
+/// x + c += d with x + c carried exactly up to the rounding of c: Knuth's two-sum of x and (c + d),
+/// valid whatever the relative sizes of x and the increment (positions cross zero).
+template <class S>
+inline void compensated_add(S& x, S& c, const S& d) {
+  const S a = c + d;
+  const S t = x + a;
+  const S bp = t - x;
+  c = (x - (t - bp)) + (a - bp);
+  x = t;
+}
+
+/// The rounding errors of q and v carried between compensated updates. The carry survives from one
+/// integrate() call to the next only if the caller did not move the state in between.
+template <class V>
+struct Compensator {
+  V cq{}, cv{};
+  V lastq{}, lastv{};
+  bool valid = false;
+
+  /// Start (or continue, if s is the state last left) a compensated run.
+  void begin(const State<V>& s) {
+    if (valid && same(lastq, s.q) && same(lastv, s.v)) return;
+    resize_like(cq, s.q);
+    resize_like(cv, s.v);
+    for (auto& e : cq) e = typename V::value_type(0);
+    for (auto& e : cv) e = typename V::value_type(0);
+  }
+  void end(const State<V>& s) {
+    resize_like(lastq, s.q);
+    resize_like(lastv, s.v);
+    assign(lastq, s.q);
+    assign(lastv, s.v);
+    valid = true;
+  }
+  void invalidate() { valid = false; }
+  /// q += d (compensated).
+  void add_q(V& q, const V& d) {
+    for (std::size_t i = 0; i < q.size(); ++i) compensated_add(q[i], cq[i], d[i]);
+  }
+  void add_v(V& v, const V& d) {
+    for (std::size_t i = 0; i < v.size(); ++i) compensated_add(v[i], cv[i], d[i]);
+  }
+  /// q += c x (compensated).
+  template <class C>
+  void axpy_q(V& q, const C& c, const V& x) {
+    for (std::size_t i = 0; i < q.size(); ++i) compensated_add(q[i], cq[i], typename V::value_type(c * x[i]));
+  }
+  template <class C>
+  void axpy_v(V& v, const C& c, const V& x) {
+    for (std::size_t i = 0; i < v.size(); ++i) compensated_add(v[i], cv[i], typename V::value_type(c * x[i]));
+  }
+
+ private:
+  static bool same(const V& x, const V& y) {
+    if (x.size() != y.size()) return false;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (!(x[i] == y[i])) return false;
+    return true;
+  }
+};
 
 /// Converts a real state to its complex counterpart (or copies if the types agree).
 template <class VOut, class VIn>

@@ -10,6 +10,9 @@
 // The combination is formed as T_ref + sum_{i != ref} c_i (T_i - T_ref) with T_ref the product of
 // largest k (sum c_i = 1 makes this exact algebra): the differences are O(h^3), so the large c_i
 // multiply small numbers and less precision is lost than in sum c_i T_i.
+// With compensated summation (EngineOptions::compensated, on by default in double) each product is
+// run on a compensated carry and returns its increment T_i - s to full precision; the combined
+// increment is added to the state with the carry of the whole run.
 #pragma once
 
 #include <algorithm>
@@ -131,7 +134,7 @@ class MpeStepper {
   /// k: the sequence; c: its coefficients in the working type; base: T_2 as a splitting scheme.
   MpeStepper(std::vector<long> k, std::vector<scalar_type> c, SplittingScheme<scalar_type> base, Force force,
              EngineOptions opt = {})
-      : k_(std::move(k)), c_(std::move(c)), base_(std::move(base), std::move(force), EngineOptions{true}), opt_(opt) {
+      : k_(std::move(k)), c_(std::move(c)), base_(std::move(base), std::move(force), EngineOptions{true, Compensation::off}), opt_(opt) {
     validate_mpe_sequence(k_);
     if (c_.size() != k_.size()) throw std::invalid_argument("MPE: one coefficient per sequence member is needed");
     ref_ = static_cast<std::size_t>(std::max_element(k_.begin(), k_.end()) - k_.begin());
@@ -145,40 +148,92 @@ class MpeStepper {
   void step(State<V>& s, real_type h) { integrate(s, h, 1); }
 
   void integrate(State<V>& s, real_type h, long n) {
-    for (long i = 0; i < n; ++i) one_step(s, h);
+    if (n <= 0) return;
+    if (opt_.mpe_naive_combination) {
+      for (long i = 0; i < n; ++i) naive_step(s, h);
+      comp_.invalidate();
+    } else if (use_compensation<scalar_type>(opt_.compensated)) {
+      comp_.begin(s);
+      for (long i = 0; i < n; ++i) one_step<true>(s, h);
+      comp_.end(s);
+    } else {
+      for (long i = 0; i < n; ++i) one_step<false>(s, h);
+    }
   }
 
  private:
-  void one_step(State<V>& s, real_type h) {
+  void first_force(const State<V>& s) {
     resize_like(a0_, s.q);
     if (starts_with_kick_) {
       // All products start with a kick at q_0: evaluate that force once (n(n+1)/2 + 1 for VV).
       base_.force()(s.q, a0_);
       ++extra_evals_;
     }
-    run_product(s, ref_, h, tref_);
+  }
+
+  // Measurements only: sum c_i T_i, uncompensated.
+  void naive_step(State<V>& s, real_type h) {
+    first_force(s);
     resize_like(acc_.q, s.q);
     resize_like(acc_.v, s.q);
     for (auto& e : acc_.q) e = scalar_type(0);
     for (auto& e : acc_.v) e = scalar_type(0);
     for (std::size_t i = 0; i < k_.size(); ++i) {
-      if (i == ref_) continue;
-      run_product(s, i, h, ti_);
-      for (std::size_t j = 0; j < s.q.size(); ++j) {
-        acc_.q[j] += c_[i] * (ti_.q[j] - tref_.q[j]);
-        acc_.v[j] += c_[i] * (ti_.v[j] - tref_.v[j]);
-      }
+      run_product<false>(s, i, h, ti_);
+      axpy(acc_.q, c_[i], ti_.q);
+      axpy(acc_.v, c_[i], ti_.v);
     }
-    for (std::size_t j = 0; j < s.q.size(); ++j) {
-      s.q[j] = tref_.q[j] + acc_.q[j];
-      s.v[j] = tref_.v[j] + acc_.v[j];
-    }
+    assign(s.q, acc_.q);
+    assign(s.v, acc_.v);
     if (is_complex_v<scalar_type> && !opt_.keep_complex) {
       project_real(s.q);
       project_real(s.v);
     }
   }
 
+  // Uncompensated: T_i are end states. Compensated: T_i are the increments T_i - s, each product run
+  // with its own compensated carry so that the increment is known to full precision; the combined
+  // increment is then added to s with the carry of the whole run.
+  template <bool Comp>
+  void one_step(State<V>& s, real_type h) {
+    first_force(s);
+    run_product<Comp>(s, ref_, h, tref_);
+    resize_like(acc_.q, s.q);
+    resize_like(acc_.v, s.q);
+    for (auto& e : acc_.q) e = scalar_type(0);
+    for (auto& e : acc_.v) e = scalar_type(0);
+    for (std::size_t i = 0; i < k_.size(); ++i) {
+      if (i == ref_) continue;
+      run_product<Comp>(s, i, h, ti_);
+      for (std::size_t j = 0; j < s.q.size(); ++j) {
+        acc_.q[j] += c_[i] * (ti_.q[j] - tref_.q[j]);
+        acc_.v[j] += c_[i] * (ti_.v[j] - tref_.v[j]);
+      }
+    }
+    if constexpr (Comp) {
+      for (std::size_t j = 0; j < s.q.size(); ++j) {
+        acc_.q[j] += tref_.q[j];
+        acc_.v[j] += tref_.v[j];
+      }
+      comp_.add_q(s.q, acc_.q);
+      comp_.add_v(s.v, acc_.v);
+    } else {
+      for (std::size_t j = 0; j < s.q.size(); ++j) {
+        s.q[j] = tref_.q[j] + acc_.q[j];
+        s.v[j] = tref_.v[j] + acc_.v[j];
+      }
+    }
+    if (is_complex_v<scalar_type> && !opt_.keep_complex) {
+      project_real(s.q);
+      project_real(s.v);
+      if constexpr (Comp) {
+        project_real(comp_.cq);
+        project_real(comp_.cv);
+      }
+    }
+  }
+
+  template <bool Comp>
   void run_product(const State<V>& s, std::size_t i, real_type h, State<V>& out) {
     resize_like(out.q, s.q);
     resize_like(out.v, s.v);
@@ -188,7 +243,19 @@ class MpeStepper {
       base_.seed_force(s.q, a0_);
     else
       base_.reset_cache();
-    base_.integrate(out, h / static_cast<real_type>(k_[i]), k_[i]);
+    if constexpr (Comp) {
+      resize_like(pc_.cq, s.q);
+      resize_like(pc_.cv, s.q);
+      for (auto& e : pc_.cq) e = scalar_type(0);
+      for (auto& e : pc_.cv) e = scalar_type(0);
+      base_.integrate_compensated(out, h / static_cast<real_type>(k_[i]), k_[i], pc_);
+      for (std::size_t j = 0; j < s.q.size(); ++j) {
+        out.q[j] = (out.q[j] - s.q[j]) + pc_.cq[j];
+        out.v[j] = (out.v[j] - s.v[j]) + pc_.cv[j];
+      }
+    } else {
+      base_.integrate(out, h / static_cast<real_type>(k_[i]), k_[i]);
+    }
   }
 
   std::vector<long> k_;
@@ -200,6 +267,7 @@ class MpeStepper {
   long extra_evals_ = 0;
   V a0_{};
   State<V> tref_{}, ti_{}, acc_{};
+  Compensator<V> comp_, pc_;
 };
 
 }  // namespace nystrom

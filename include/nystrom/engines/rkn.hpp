@@ -100,11 +100,19 @@ class RknStepper {
   void step(State<V>& s, real_type h) { integrate(s, h, 1); }
 
   void integrate(State<V>& s, real_type h, long n) {
-    for (long k = 0; k < n; ++k) one_step(s, h, nullptr);
+    if (n <= 0) return;
+    if (use_compensation<scalar_type>(opt_.compensated)) {
+      comp_.begin(s);
+      for (long k = 0; k < n; ++k) one_step(s, h, nullptr, &comp_);
+      comp_.end(s);
+    } else {
+      for (long k = 0; k < n; ++k) one_step(s, h, nullptr, nullptr);
+    }
   }
 
   /// One step that also returns the embedded error estimate (q, v) in err (if the tableau has one).
-  void step_with_error(State<V>& s, real_type h, State<V>& err) { one_step(s, h, &err); }
+  /// (Not compensated: step control moves the state between steps.)
+  void step_with_error(State<V>& s, real_type h, State<V>& err) { one_step(s, h, &err, nullptr); }
 
  private:
   struct Nz {
@@ -112,7 +120,7 @@ class RknStepper {
     scalar_type a;
   };
 
-  void one_step(State<V>& st, real_type hr, State<V>* err) {
+  void one_step(State<V>& st, real_type hr, State<V>* err, Compensator<V>* comp) {
     const std::size_t s = t_.stages();
     const scalar_type h(hr), h2 = h * h;
     for (auto& f : f_) resize_like(f, st.q);
@@ -141,14 +149,35 @@ class RknStepper {
           axpy(err->v, (t_.B[i] - t_.Bhat[i]) * h, f_[i]);
         }
     }
-    axpy(st.q, h, st.v);
-    for (std::size_t i = 0; i < s; ++i)
-      if (!(t_.b[i] == scalar_type(0))) axpy(st.q, t_.b[i] * h2, f_[i]);
-    for (std::size_t i = 0; i < s; ++i)
-      if (!(t_.B[i] == scalar_type(0))) axpy(st.v, t_.B[i] * h, f_[i]);
+    if (comp) {
+      // One increment per step for q and for v, added with compensation.
+      resize_like(dq_, st.q);
+      resize_like(dv_, st.q);
+      for (std::size_t j = 0; j < st.q.size(); ++j) {
+        dq_[j] = scalar_type(0);
+        dv_[j] = scalar_type(0);
+      }
+      for (std::size_t i = 0; i < s; ++i)
+        if (!(t_.b[i] == scalar_type(0))) axpy(dq_, t_.b[i] * h2, f_[i]);
+      axpy(dq_, h, st.v);
+      for (std::size_t i = 0; i < s; ++i)
+        if (!(t_.B[i] == scalar_type(0))) axpy(dv_, t_.B[i] * h, f_[i]);
+      comp->add_q(st.q, dq_);
+      comp->add_v(st.v, dv_);
+    } else {
+      axpy(st.q, h, st.v);
+      for (std::size_t i = 0; i < s; ++i)
+        if (!(t_.b[i] == scalar_type(0))) axpy(st.q, t_.b[i] * h2, f_[i]);
+      for (std::size_t i = 0; i < s; ++i)
+        if (!(t_.B[i] == scalar_type(0))) axpy(st.v, t_.B[i] * h, f_[i]);
+    }
     if (project) {
       project_real(st.q);
       project_real(st.v);
+      if (comp) {
+        project_real(comp->cq);
+        project_real(comp->cv);
+      }
     }
     if (fsal_ && !project) {
       // The last stage was evaluated at q_{n+1} up to rounding; reuse it exactly as the
@@ -177,6 +206,8 @@ class RknStepper {
   std::vector<V> f_;
   V y_{};
   V aq_{};
+  V dq_{}, dv_{};
+  Compensator<V> comp_;
   bool cache_valid_ = false;
   long evals_ = 0;
 };

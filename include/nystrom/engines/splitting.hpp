@@ -116,6 +116,24 @@ class SplittingStepper {
   /// n steps of size h.
   void integrate(State<V>& s, real_type h, long n) {
     if (n <= 0) return;
+    if (use_compensation<scalar_type>(opt_.compensated)) {
+      comp_.begin(s);
+      run<true>(s, h, n, comp_);
+      comp_.end(s);
+    } else {
+      run<false>(s, h, n, comp_);
+    }
+  }
+
+  /// n compensated steps of size h with the caller's carry c (c.begin() is the caller's business;
+  /// used by the multi-product engine to obtain each product's increment to full precision).
+  void integrate_compensated(State<V>& s, real_type h, long n, Compensator<V>& c) {
+    if (n > 0) run<true>(s, h, n, c);
+  }
+
+ private:
+  template <bool Comp>
+  void run(State<V>& s, real_type h, long n, Compensator<V>& c) {
     resize_like(a_, s.q);
     check_cache(s.q);
     const auto& st = scheme_.steps;
@@ -126,10 +144,14 @@ class SplittingStepper {
     const bool merge = !project && m > 1 && st.front().flow == st.back().flow;
     if (!merge) {
       for (long k = 0; k < n; ++k) {
-        for (std::size_t i = 0; i < m; ++i) apply(s, st[i].flow, hc_[i]);
+        for (std::size_t i = 0; i < m; ++i) apply<Comp>(s, st[i].flow, hc_[i], c);
         if (project) {
           project_real(s.q);
           project_real(s.v);
+          if constexpr (Comp) {
+            project_real(c.cq);
+            project_real(c.cv);
+          }
           cache_valid_ = false;
         }
       }
@@ -137,19 +159,22 @@ class SplittingStepper {
       return;
     }
     const scalar_type joined = hc_[m - 1] + hc_[0];
-    for (std::size_t i = 0; i + 1 < m; ++i) apply(s, st[i].flow, hc_[i]);
+    for (std::size_t i = 0; i + 1 < m; ++i) apply<Comp>(s, st[i].flow, hc_[i], c);
     for (long k = 1; k < n; ++k) {
-      apply(s, st[0].flow, joined);
-      for (std::size_t i = 1; i + 1 < m; ++i) apply(s, st[i].flow, hc_[i]);
+      apply<Comp>(s, st[0].flow, joined, c);
+      for (std::size_t i = 1; i + 1 < m; ++i) apply<Comp>(s, st[i].flow, hc_[i], c);
     }
-    apply(s, st[m - 1].flow, hc_[m - 1]);
+    apply<Comp>(s, st[m - 1].flow, hc_[m - 1], c);
     remember(s.q);
   }
 
- private:
-  void apply(State<V>& s, Flow f, const scalar_type& c) {
+  template <bool Comp>
+  void apply(State<V>& s, Flow f, const scalar_type& c, Compensator<V>& comp) {
     if (f == Flow::drift) {
-      axpy(s.q, c, s.v);
+      if constexpr (Comp)
+        comp.axpy_q(s.q, c, s.v);
+      else
+        axpy(s.q, c, s.v);
       cache_valid_ = false;
     } else {
       if (!cache_valid_) {
@@ -157,7 +182,10 @@ class SplittingStepper {
         ++evals_;
         cache_valid_ = true;
       }
-      axpy(s.v, c, a_);
+      if constexpr (Comp)
+        comp.axpy_v(s.v, c, a_);
+      else
+        axpy(s.v, c, a_);
     }
   }
   // The cache survives between calls only if the caller did not move q.
@@ -183,6 +211,7 @@ class SplittingStepper {
   SplittingScheme<scalar_type> scheme_;
   Force force_;
   EngineOptions opt_;
+  Compensator<V> comp_;
   V a_{};
   V aq_{};
   bool cache_valid_ = false;
