@@ -60,13 +60,12 @@ Row measure(const std::string& spec, long steps_per_period, long periods) {
 }  // namespace
 
 TEST(MpeCombination, RoundoffAtOrders8To16) {
-  for (const char* m : {"M8", "M10", "M12"}) {
+  // Measured (double, e = 0.5, 100 steps/period, 100 periods): naive/difference 19 to 750,
+  // naive/compensated 260 to 2100. The margins below are several times smaller.
+  for (const char* m : {"M8", "M10", "M12", "M14", "M16"}) {
     const Row r = measure(m, 100, 100);
-    EXPECT_LT(r.compensated, r.naive) << m;
-  }
-  for (const char* m : {"M14", "M16"}) {
-    const Row r = measure(m, 100, 100);
-    EXPECT_LT(r.difference, r.naive) << m;
-    EXPECT_LT(r.compensated * 10, r.naive) << m;
+    EXPECT_LT(r.difference * 5, r.naive) << m;
+    EXPECT_LT(r.compensated * 20, r.naive) << m;
+    EXPECT_LT(r.compensated, r.difference) << m;
   }
 }
