@@ -1,0 +1,308 @@
+// Cost of the library's engines on Kepler (Chin eqs 35-36, e = 0.9) in double: nanoseconds per step of
+// VV, FR, M4 and M8 through the library (make_integrator + integrate over a batch of steps) against a
+// plain hand-written loop of the same method, measured in the same run:
+//
+//   VV        velocity Verlet, FSAL, the half kicks of consecutive steps merged (leapfrog form)
+//   FR        Forest-Ruth position-first: 7 sub-steps, 3 forces, the last drift merged with the next first
+//   M4        Chin eqs (33)-(34): the {1,2} PV multi-product method written out, 3 forces, against the
+//             MPE engine (catalog "M4"); "M4-RKN" the same loop against the RKN engine (catalog
+//             "M4-RKN"); "M4-sum" the MPE engine against the hand-written sum of products of eq (19)
+//   M8        the {1,2,3,4} PV multi-product method, sum of products with the exact c_i of eq (21),
+//             10 forces
+//
+// One benchmark iteration integrates a batch of kSteps steps from the apocentre (h = 2 pi / kSteps, one
+// period per batch), the state reset every iteration (both variants then evaluate the first force anew).
+// Both variants use the same force arithmetic (r2 = x^2 + y^2, r = sqrt(r2), a = -q / (r2 r)).
+//
+// Before benchmarking, every hand-written loop is checked against the library (same method, so the final
+// states must agree to rounding). After the run, a table gives ns/step of both variants (the minimum over
+// repetitions of the CPU time, robust on a shared machine) and the ratio library / hand-written.
+// Target: ratio <= 1.10. Where the library has compensated summation (EngineOptions::compensated), it
+// is measured with its default options and with compensation off ("plain", like the hand-written loops).
+//
+//   bench_kepler --benchmark_repetitions=5     (the default here: 5 repetitions, 0.2 s each)
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "nystrom/engines/integrator.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/kepler.hpp"
+
+using namespace nystrom;
+
+namespace {
+
+constexpr double kEcc = 0.9;
+constexpr long kSteps = 2000;  // per batch: one period at h = 2 pi / 2000
+
+using V = std::array<double, 2>;
+
+State<V> start() { return KeplerProblem<double>(kEcc).initial_state(); }
+double step_size() { return 2 * std::acos(-1.0) / kSteps; }
+
+// ---- hand-written loops -----------------------------------------------------------------------------
+
+struct P {
+  double x, y, vx, vy;
+};
+
+inline void force(double x, double y, double& ax, double& ay) {
+  const double r2 = x * x + y * y;
+  const double r = std::sqrt(r2);
+  const double m = -1.0 / (r2 * r);
+  ax = m * x;
+  ay = m * y;
+}
+
+/// Velocity Verlet, FSAL, with the half kicks of consecutive steps merged.
+P hand_vv(P s, double h, long n) {
+  double ax, ay;
+  force(s.x, s.y, ax, ay);
+  s.vx += 0.5 * h * ax;
+  s.vy += 0.5 * h * ay;
+  for (long k = 0; k < n; ++k) {
+    s.x += h * s.vx;
+    s.y += h * s.vy;
+    force(s.x, s.y, ax, ay);
+    const double c = (k + 1 < n) ? h : 0.5 * h;
+    s.vx += c * ax;
+    s.vy += c * ay;
+  }
+  return s;
+}
+
+/// Forest-Ruth, position-first: drift th/2, kick th, drift (1-t)h/2, kick (1-2t)h, drift (1-t)h/2,
+/// kick th, drift th/2; the last drift merged with the next step's first.
+P hand_fr(P s, double h, long n) {
+  const double theta = 1.0 / (2.0 - std::cbrt(2.0));
+  const double d1 = 0.5 * theta * h, d2 = 0.5 * (1 - theta) * h, k1 = theta * h, k2 = (1 - 2 * theta) * h;
+  double ax, ay;
+  s.x += d1 * s.vx;
+  s.y += d1 * s.vy;
+  for (long k = 0; k < n; ++k) {
+    force(s.x, s.y, ax, ay);
+    s.vx += k1 * ax;
+    s.vy += k1 * ay;
+    s.x += d2 * s.vx;
+    s.y += d2 * s.vy;
+    force(s.x, s.y, ax, ay);
+    s.vx += k2 * ax;
+    s.vy += k2 * ay;
+    s.x += d2 * s.vx;
+    s.y += d2 * s.vy;
+    force(s.x, s.y, ax, ay);
+    s.vx += k1 * ax;
+    s.vy += k1 * ay;
+    const double d = (k + 1 < n) ? 2 * d1 : d1;
+    s.x += d * s.vx;
+    s.y += d * s.vy;
+  }
+  return s;
+}
+
+/// M4, Chin eqs (33)-(34).
+P hand_m4(P s, double h, long n) {
+  const double h2 = h * h;
+  for (long k = 0; k < n; ++k) {
+    double a1x, a1y, a2x, a2y, a3x, a3y;
+    force(s.x + 0.25 * h * s.vx, s.y + 0.25 * h * s.vy, a1x, a1y);
+    force(s.x + 0.5 * h * s.vx, s.y + 0.5 * h * s.vy, a2x, a2y);
+    force(s.x + 0.75 * h * s.vx + 0.25 * h2 * a1x, s.y + 0.75 * h * s.vy + 0.25 * h2 * a1y, a3x, a3y);
+    s.x += h * s.vx + (h2 / 6) * (3 * a1x - a2x + a3x);
+    s.y += h * s.vy + (h2 / 6) * (3 * a1y - a2y + a3y);
+    s.vx += (h / 3) * (2 * a1x - a2x + 2 * a3x);
+    s.vy += (h / 3) * (2 * a1y - a2y + 2 * a3y);
+  }
+  return s;
+}
+
+/// sum_k c_k PV^k(h/k), k = 1..K, the drifts between the k applications of PV merged.
+template <int K>
+P hand_mpe(P s, double h, long n, const double (&c)[K]) {
+  for (long step = 0; step < n; ++step) {
+    P acc{0, 0, 0, 0};
+    for (int k = 1; k <= K; ++k) {
+      const double hk = h / k, half = 0.5 * hk;
+      double x = s.x + half * s.vx, y = s.y + half * s.vy, vx = s.vx, vy = s.vy, ax, ay;
+      for (int j = 0; j < k; ++j) {
+        force(x, y, ax, ay);
+        vx += hk * ax;
+        vy += hk * ay;
+        const double d = (j + 1 < k) ? hk : half;
+        x += d * vx;
+        y += d * vy;
+      }
+      const double ck = c[k - 1];
+      acc.x += ck * x;
+      acc.y += ck * y;
+      acc.vx += ck * vx;
+      acc.vy += ck * vy;
+    }
+    s = acc;
+  }
+  return s;
+}
+
+/// M4 as the sum of products, eq (19): c = (-1/3, 4/3).
+P hand_m4_products(P s, double h, long n) {
+  static constexpr double c[2] = {-1.0 / 3, 4.0 / 3};
+  return hand_mpe(s, h, n, c);
+}
+
+/// M8: c = (-1/360, 16/45, -729/280, 1024/315), eq (21).
+P hand_m8(P s, double h, long n) {
+  static constexpr double c[4] = {-1.0 / 360, 16.0 / 45, -729.0 / 280, 1024.0 / 315};
+  return hand_mpe(s, h, n, c);
+}
+
+using HandLoop = P (*)(P, double, long);
+
+struct Case {
+  const char* name;     // the benchmark label
+  const char* method;   // the catalog method of the library variant
+  HandLoop hand;        // the hand-written loop
+};
+
+const std::vector<Case>& cases() {
+  static const std::vector<Case> c{{"VV", "VV", hand_vv},
+                                   {"FR", "FR", hand_fr},
+                                   {"M4", "M4", hand_m4},                // MPE engine vs eqs (33)-(34)
+                                   {"M4-sum", "M4", hand_m4_products},   // MPE engine vs sum of products
+                                   {"M4-RKN", "M4-RKN", hand_m4},        // RKN engine vs eqs (33)-(34)
+                                   {"M8", "M8", hand_m8}};
+  return c;
+}
+
+P to_p(const State<V>& s) { return {s.q[0], s.q[1], s.v[0], s.v[1]}; }
+
+// ---- benchmarks ---------------------------------------------------------------------------------------
+
+// Compensated summation of the updates (EngineOptions::compensated, where the library has it; on by
+// default in double) costs extra additions that the plain hand-written loops do not do: the library is
+// measured with its default options and, where the option exists, with compensation off ("plain").
+template <class O>
+constexpr bool has_compensation_option = requires(O o) { decltype(o.compensated)::off; };
+
+template <class O>
+O plain_options(O o) {
+  if constexpr (has_compensation_option<O>) o.compensated = decltype(o.compensated)::off;
+  return o;
+}
+
+void bm_library(benchmark::State& state, const Case& c, bool plain) {
+  const EngineOptions opt = plain ? plain_options(EngineOptions{}) : EngineOptions{};
+  auto integ = make_integrator<V>(resolve_method(c.method), KeplerForce{}, opt);
+  const double h = step_size();
+  const State<V> s0 = start();
+  for (auto _ : state) {
+    State<V> s = s0;
+    integ.integrate(s, h, kSteps);
+    benchmark::DoNotOptimize(s);
+  }
+  state.SetItemsProcessed(state.iterations() * kSteps);
+}
+
+void bm_hand(benchmark::State& state, const Case& c) {
+  const double h = step_size();
+  const P s0 = to_p(start());
+  for (auto _ : state) {
+    P s = s0;
+    benchmark::DoNotOptimize(s);
+    s = c.hand(s, h, kSteps);
+    benchmark::DoNotOptimize(s);
+  }
+  state.SetItemsProcessed(state.iterations() * kSteps);
+}
+
+/// The hand-written loops are the library's methods: final states agree to rounding.
+bool check_hand_loops() {
+  bool ok = true;
+  for (const auto& c : cases()) {
+    auto integ = make_integrator<V>(resolve_method(c.method), KeplerForce{}, plain_options(EngineOptions{}));
+    State<V> s = start();
+    integ.integrate(s, step_size(), kSteps);
+    const P lib = to_p(s), hand = c.hand(to_p(start()), step_size(), kSteps);
+    const double diff = std::max({std::abs(lib.x - hand.x), std::abs(lib.y - hand.y), std::abs(lib.vx - hand.vx),
+                                  std::abs(lib.vy - hand.vy)});
+    std::printf("check %-7s library vs hand-written after one period: max |difference| = %.2e\n", c.name, diff);
+    if (!(diff < 1e-8)) {
+      std::fprintf(stderr, "error: the hand-written %s loop does not reproduce the library's %s\n", c.name, c.method);
+      ok = false;
+    }
+  }
+  return ok;
+}
+
+/// Console output as usual, plus the minimum CPU time per step of every benchmark for the summary.
+class SummaryReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const auto& r : runs) {
+      if (r.run_type != Run::RT_Iteration || r.error_occurred || r.iterations == 0) continue;
+      const double ns_per_step = r.cpu_accumulated_time * 1e9 / (static_cast<double>(r.iterations) * kSteps);
+      const std::string name = r.run_name.function_name;
+      auto it = best_.find(name);
+      if (it == best_.end() || ns_per_step < it->second) best_[name] = ns_per_step;
+    }
+  }
+  void summary() const {
+    std::printf("\nKepler e = %.1f, double, %ld steps per batch; minimum over repetitions of CPU time per step\n", kEcc,
+                kSteps);
+    const bool plain = has_compensation_option<EngineOptions>;
+    std::printf("%-8s %10s %12s %9s", "method", "hand ns", "library ns", "lib/hand");
+    if (plain) std::printf(" %12s %9s", "plain ns", "plain/hand");
+    std::printf("\n");
+    for (const auto& c : cases()) {
+      const auto hand = best_.find(std::string("hand/") + c.name), lib = best_.find(std::string("library/") + c.name);
+      if (lib == best_.end() || hand == best_.end()) continue;
+      const double ratio = lib->second / hand->second;
+      std::printf("%-8s %10.2f %12.2f %9.3f", c.name, hand->second, lib->second, ratio);
+      const auto pl = best_.find(std::string("library-plain/") + c.name);
+      if (plain && pl != best_.end()) std::printf(" %12.2f %9.3f", pl->second, pl->second / hand->second);
+      std::printf("\n");
+    }
+    std::printf("(target: library / hand-written <= 1.10%s)\n",
+                plain ? "; 'plain' = the library with compensated summation off, as the hand-written loops" : "");
+  }
+
+ private:
+  std::map<std::string, double> best_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (const auto& c : cases()) {
+    benchmark::RegisterBenchmark((std::string("hand/") + c.name).c_str(), [&c](benchmark::State& s) { bm_hand(s, c); })
+        ->MinTime(0.2);
+    benchmark::RegisterBenchmark((std::string("library/") + c.name).c_str(),
+                                 [&c](benchmark::State& s) { bm_library(s, c, false); })
+        ->MinTime(0.2);
+    if (has_compensation_option<EngineOptions>)
+      benchmark::RegisterBenchmark((std::string("library-plain/") + c.name).c_str(),
+                                   [&c](benchmark::State& s) { bm_library(s, c, true); })
+          ->MinTime(0.2);
+  }
+  // Five repetitions unless the command line says otherwise.
+  std::vector<char*> args(argv, argv + argc);
+  std::string reps = "--benchmark_repetitions=5";
+  if (std::none_of(args.begin() + 1, args.end(), [](const char* a) { return std::string(a).rfind("--benchmark_repetitions", 0) == 0; }))
+    args.push_back(reps.data());
+  int n = static_cast<int>(args.size());
+  benchmark::Initialize(&n, args.data());
+  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
+  if (!check_hand_loops()) return 1;
+  SummaryReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  reporter.summary();
+  benchmark::Shutdown();
+  return 0;
+}
