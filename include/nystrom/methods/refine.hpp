@@ -38,10 +38,8 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
-#include <tuple>
 #include <type_traits>
 #include <utility>
 #include <variant>
@@ -81,10 +79,6 @@ struct Dual {
   Dual(int x) : v(V(bigfloat(x))) {}  // NOLINT: constants in the order-condition code (C(0), C(1))
   explicit Dual(V x) : v(std::move(x)) {}
   Dual(V x, std::vector<V> dx) : v(std::move(x)), d(std::move(dx)) {}
-
-  bool constant() const {
-    return std::all_of(d.begin(), d.end(), [](const V& x) { return is_zero(x); });
-  }
 
   friend Dual operator+(const Dual& a, const Dual& b) { return combine(a, b, a.v + b.v, 1); }
   friend Dual operator-(const Dual& a, const Dual& b) { return combine(a, b, a.v - b.v, -1); }
