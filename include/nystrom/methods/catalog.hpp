@@ -6,6 +6,7 @@
 //   mpe:1,2,4             MPE on position Verlet with the given sequence
 //   mpe-vv:1,2,3          MPE on velocity Verlet
 //   adjoint:NAME          the adjoint of a splitting method (sub-steps reversed)
+//   file:PATH             a splitting method from a method file (format: nystrom/analysis/method_file.hpp)
 //   triplejump:P          Yoshida's triple jump of even order P on position Verlet (also triplejump-pv:P);
 //   triplejump-vv:P       on velocity Verlet (compositions.hpp)
 //   suzuki:P              Suzuki's 5-fold fractal composition of even order P on position Verlet
@@ -20,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "nystrom/analysis/method_file.hpp"
 #include "nystrom/methods/blanes_moan2002.hpp"
 #include "nystrom/methods/chin2010.hpp"
 #include "nystrom/methods/compositions.hpp"
@@ -134,6 +136,7 @@ inline MethodDef resolve_method(const std::string& spec) {
     if (ls.rfind(prefix, 0) == 0)
       return finalize(
           methods::suzuki_method(methods::parse_composition_order(spec.substr(prefix.size()), spec), base, ls));
+  if (ls.rfind("file:", 0) == 0) return finalize(analysis::method_def_from_file(spec.substr(5)));  // analysis/method_file.hpp
   if (ls.rfind("adjoint:", 0) == 0) {
     MethodDef base = resolve_method(spec.substr(8));
     auto build = base.build;
