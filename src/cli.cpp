@@ -123,6 +123,11 @@ std::string quote_gnuplot(const std::string& s) {
 
 void plot_loglog(const std::string& png_path, const std::string& title, const std::string& xlabel,
                  const std::string& ylabel, const std::vector<Series>& series) {
+  plot_xy(png_path, title, xlabel, ylabel, series, PlotAxes{});
+}
+
+void plot_xy(const std::string& png_path, const std::string& title, const std::string& xlabel,
+             const std::string& ylabel, const std::vector<Series>& series, const PlotAxes& axes) {
   namespace fs = std::filesystem;
   if (png_path.empty()) throw UsageError("empty plot file name");
   const fs::path target(png_path);
@@ -132,7 +137,8 @@ void plot_loglog(const std::string& png_path, const std::string& title, const st
   std::ostringstream script;
   script << "set terminal pngcairo size 900,650 enhanced font 'Sans,11'\n"
          << "set output " << quote_gnuplot(tmp_png.string()) << "\n"
-         << "set logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
+         << (axes.logx ? "set logscale x\nset format x '10^{%L}'\n" : "")
+         << (axes.logy ? "set logscale y\nset format y '10^{%L}'\n" : "")
          << "set grid\nset key outside right top\n"
          << "set title " << quote_gnuplot(title) << "\n"
          << "set xlabel " << quote_gnuplot(xlabel) << "\n"
@@ -144,15 +150,21 @@ void plot_loglog(const std::string& png_path, const std::string& title, const st
     std::ostringstream block;
     int points = 0;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i)
-      if (s.x[i] > 0 && s.y[i] > 0 && std::isfinite(s.x[i]) && std::isfinite(s.y[i])) {
+      if ((s.x[i] > 0 || !axes.logx) && (s.y[i] > 0 || !axes.logy) && std::isfinite(s.x[i]) && std::isfinite(s.y[i])) {
         block.precision(17);
         block << s.x[i] << " " << s.y[i] << "\n";
         ++points;
       }
     if (points == 0) continue;
     script << "$d" << idx << " << EOD\n" << block.str() << "EOD\n";
-    plots.push_back("$d" + std::to_string(idx) + " using 1:2 with linespoints lw 2 pt " + std::to_string(1 + idx % 12) +
-                    " title " + quote_gnuplot(s.label));
+    const std::string pt = std::to_string(s.point_type > 0 ? s.point_type : 1 + idx % 12);
+    std::string with;
+    if (s.style.empty() || s.style == "linespoints") with = "linespoints lw 2 pt " + pt;
+    else if (s.style == "lines") with = "lines lw 2";
+    else if (s.style == "points") with = "points ps 1.3 pt " + pt;
+    else if (s.style == "thick") with = "lines lw 6 lc rgb '#80808080'";
+    else throw std::invalid_argument("unknown plot style '" + s.style + "'");
+    plots.push_back("$d" + std::to_string(idx) + " using 1:2 with " + with + " title " + quote_gnuplot(s.label));
     ++idx;
   }
   if (plots.empty()) throw UsageError("nothing to plot: every value is zero, negative or not finite");

@@ -69,14 +69,25 @@ class Progress {
   bool enabled_;
 };
 
-/// One curve of a log-log plot: x, y pairs (non-positive y are skipped).
+/// One curve of a plot: x, y pairs (on a log axis, non-positive values are skipped).
 struct Series {
   std::string label;
   std::vector<double> x, y;
+  std::string style{};  // "linespoints" (default when empty), "lines", "points", or "thick" (a wide line)
+  int point_type = 0;   // gnuplot point type (0: chosen from the series index)
+};
+
+/// Axis scales of plot_xy.
+struct PlotAxes {
+  bool logx = true, logy = true;
 };
 
 /// Draws a log-log plot with gnuplot (pngcairo) into png_path. Throws if gnuplot is missing or fails.
 void plot_loglog(const std::string& png_path, const std::string& title, const std::string& xlabel,
                  const std::string& ylabel, const std::vector<Series>& series);
+
+/// The same with a choice of linear or logarithmic axes.
+void plot_xy(const std::string& png_path, const std::string& title, const std::string& xlabel,
+             const std::string& ylabel, const std::vector<Series>& series, const PlotAxes& axes);
 
 }  // namespace nystrom::cli
