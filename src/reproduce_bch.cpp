@@ -92,7 +92,7 @@ TargetResult gurkan_table43(const Context& ctx) {
 
   std::string csv = "method,term,published_re,published_im,computed_re,computed_im,printed_digits,last_digit_offset\n";
   std::string tb = "Each cell: published / computed (rounded to the printed digits); a mark after the computed value "
-                   "gives its offset in units of the last printed digit.\n\n| method |";
+                   "gives its offset in units of the last printed digit, or says that only the sign differs.\n\n| method |";
   for (const char* t : kTerms) tb += fmt::format(" {} |", t);
   tb += " norm | digits agreeing |\n|---|---|---|---|---|---|---|---|\n";
   Series pub_vs{"X_i (published sign)", {}, {}, "points", 7}, neg_vs{"X_i (opposite sign)", {}, {}, "points", 6},
@@ -124,7 +124,9 @@ TargetResult gurkan_table43(const Context& ctx) {
       else worst_real_imag = std::max(worst_real_imag, rel_other);
       const double u = unit_of(pub, 2);
       tb += fmt::format(" {} / {}{} |", show(p.x[k]), show(cplx ? cd(0, std::lround(got / u) * u) : cd(std::lround(got / u) * u, 0)),
-                        off == 0 ? "" : fmt::format(" ({:+d})", off));
+                        off == 0                                                      ? ""
+                        : pub * got < 0 && digit_offset(std::abs(pub), std::abs(got), 2) == 0 ? " (opposite sign)"
+                                                                                               : fmt::format(" ({:+d})", off));
       csv += fmt::format("{},{},{:.2g},{:.2g},{:.17g},{:.17g},2,{}\n", p.method, kTerms[k], p.x[k].real(), p.x[k].imag(),
                          v.real(), v.imag(), off);
       (pub * got > 0 ? pub_vs : neg_vs).x.push_back(std::abs(pub));
