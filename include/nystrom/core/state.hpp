@@ -21,6 +21,9 @@ namespace nystrom {
 /// automatic: on for float and double (as in Hairer's GNI codes), off for wider types.
 enum class Compensation : unsigned char { automatic, on, off };
 
+/// How the multi-product engine schedules its independent products (EngineOptions::mpe_schedule).
+enum class MpeSchedule : unsigned char { automatic, sequential, lockstep, concurrent };
+
 /// Options shared by all engines.
 struct EngineOptions {
   /// Complex-coefficient methods: keep the complexified state instead of dropping the
@@ -32,6 +35,16 @@ struct EngineOptions {
   /// MPE only, for measurements: combine the products naively as sum c_i T_i instead of
   /// T_ref + sum c_i (T_i - T_ref).
   bool mpe_naive_combination = false;
+  /// MPE only: how the independent products of a step are scheduled. Every schedule gives bitwise the
+  /// same result. lockstep: sub-step j of every product before sub-step j + 1 of any, so that the
+  /// processor overlaps their independent chains of force evaluations (small systems); concurrent: the
+  /// products on mpe_threads OpenMP threads, each with its own copy of the force functor (expensive
+  /// forces such as N-body; the force's own threading is then nested and runs serially); sequential:
+  /// one product after the other; automatic: lockstep for fixed-size states (std::array), else
+  /// sequential.
+  MpeSchedule mpe_schedule = MpeSchedule::automatic;
+  /// Threads of the concurrent schedule (0: OpenMP's default). Without OpenMP it runs sequentially.
+  int mpe_threads = 0;
 };
 
 /// Whether compensated summation is used for scalar type S under option c.

@@ -16,6 +16,8 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <exception>
 #include <cstddef>
 #include <numeric>
 #include <set>
@@ -26,6 +28,10 @@
 #include <vector>
 
 #include <gmpxx.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/splitting.hpp"
@@ -139,9 +145,33 @@ class MpeStepper {
     if (c_.size() != k_.size()) throw std::invalid_argument("MPE: one coefficient per sequence member is needed");
     ref_ = static_cast<std::size_t>(std::max_element(k_.begin(), k_.end()) - k_.begin());
     starts_with_kick_ = base_.scheme().steps.front().flow == Flow::kick;
+    products_.resize(k_.size());
+    lockstep_ = base_.lockstep_capable() && (opt_.mpe_schedule == MpeSchedule::lockstep ||
+                                             (opt_.mpe_schedule == MpeSchedule::automatic && is_std_array<V>::value));
+    concurrent_ = opt_.mpe_schedule == MpeSchedule::concurrent;
+    if (opt_.mpe_threads < 0) throw std::invalid_argument("MPE: the number of threads must be >= 0");
+    if (lockstep_ || concurrent_) {
+      pa_.resize(k_.size());
+      pcq_.resize(k_.size());
+      pcv_.resize(k_.size());
+    }
+    if (concurrent_) {
+      // One copy of the base (and of its force functor) per product; the longest products first.
+      workers_.assign(k_.size(), base_);
+      order_.resize(k_.size());
+      std::iota(order_.begin(), order_.end(), std::size_t{0});
+      std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return k_[a] > k_[b]; });
+    }
   }
 
-  long force_evals() const { return base_.force_evals() + extra_evals_; }
+  /// Whether the products of a step run in lockstep (EngineOptions::mpe_schedule).
+  bool lockstep() const { return lockstep_; }
+
+  long force_evals() const {
+    long e = base_.force_evals() + extra_evals_;
+    for (const auto& w : workers_) e += w.force_evals();
+    return e;
+  }
   Force& force() { return base_.force(); }
   const std::vector<long>& sequence() const { return k_; }
 
@@ -152,12 +182,32 @@ class MpeStepper {
     if (opt_.mpe_naive_combination) {
       for (long i = 0; i < n; ++i) naive_step(s, h);
       comp_.invalidate();
-    } else if (use_compensation<scalar_type>(opt_.compensated)) {
+      return;
+    }
+    // The base's coefficients times h / k_i, product after product.
+    const std::size_t m = base_.scheme().steps.size();
+    scaled_.resize(k_.size() * m);
+    for (std::size_t i = 0; i < k_.size(); ++i) {
+      base_.scale_coefficients(h / static_cast<real_type>(k_[i]), hc_);
+      std::copy(hc_.begin(), hc_.end(), scaled_.begin() + static_cast<std::ptrdiff_t>(i * m));
+    }
+    // A fixed-size state and carry live in locals for the loop (see SplittingStepper::run).
+    constexpr bool local = is_std_array<V>::value;
+    std::conditional_t<local, State<V>, State<V>&> x = s;
+    if (use_compensation<scalar_type>(opt_.compensated)) {
       comp_.begin(s);
-      for (long i = 0; i < n; ++i) one_step<true>(s, h);
+      std::conditional_t<local, Compensator<V>, Compensator<V>&> c = comp_;
+      if (!(lockstep_ && dispatch_fixed<true>(x, c, n)))
+        for (long i = 0; i < n; ++i) one_step<true>(x, c);
+      if constexpr (local) {
+        s = x;
+        comp_ = c;
+      }
       comp_.end(s);
     } else {
-      for (long i = 0; i < n; ++i) one_step<false>(s, h);
+      if (!(lockstep_ && dispatch_fixed<false>(x, comp_, n)))
+        for (long i = 0; i < n; ++i) one_step<false>(x, comp_);
+      if constexpr (local) s = x;
     }
   }
 
@@ -193,46 +243,253 @@ class MpeStepper {
 
   // Uncompensated: T_i are end states. Compensated: T_i are the increments T_i - s, each product run
   // with its own compensated carry so that the increment is known to full precision; the combined
-  // increment is then added to s with the carry of the whole run.
+  // increment is then added to s with the carry `comp` of the whole run.
   template <bool Comp>
-  void one_step(State<V>& s, real_type h) {
-    first_force(s);
-    run_product<Comp>(s, ref_, h, tref_);
-    resize_like(acc_.q, s.q);
-    resize_like(acc_.v, s.q);
-    for (auto& e : acc_.q) e = scalar_type(0);
-    for (auto& e : acc_.v) e = scalar_type(0);
-    for (std::size_t i = 0; i < k_.size(); ++i) {
-      if (i == ref_) continue;
-      run_product<Comp>(s, i, h, ti_);
-      for (std::size_t j = 0; j < s.q.size(); ++j) {
-        acc_.q[j] += c_[i] * (ti_.q[j] - tref_.q[j]);
-        acc_.v[j] += c_[i] * (ti_.v[j] - tref_.v[j]);
+  NYSTROM_ALWAYS_INLINE void one_step(State<V>& s, Compensator<V>& comp) {
+    // Fixed-size states, forces and carries live in locals (registers); see SplittingStepper::run.
+    constexpr bool local = is_std_array<V>::value;
+    std::conditional_t<local, V, V&> a0 = a0_, a = a_, pcq = pc_.cq, pcv = pc_.cv;
+    resize_like(a0, s.q);
+    resize_like(a, s.q);
+    if (starts_with_kick_) {
+      // All products start with a kick at q_0: evaluate that force once (n(n+1)/2 + 1 for VV).
+      base_.force()(s.q, a0);
+      ++extra_evals_;
+    }
+    const std::size_t m = base_.scheme().steps.size();
+    auto product = [&](std::size_t i, State<V>& out) NYSTROM_ALWAYS_INLINE {
+      resize_like(out.q, s.q);
+      resize_like(out.v, s.v);
+      assign(out.q, s.q);
+      assign(out.v, s.v);
+      bool valid = starts_with_kick_;
+      if (valid) assign(a, a0);
+      if constexpr (Comp) {
+        resize_like(pcq, s.q);
+        resize_like(pcv, s.q);
+        for (auto& e : pcq) e = scalar_type(0);
+        for (auto& e : pcv) e = scalar_type(0);
+      }
+      base_.template advance_scaled<Comp>(out, a, valid, scaled_.data() + i * m, k_[i], pcq, pcv);
+      if constexpr (Comp) {
+        for (std::size_t j = 0; j < s.q.size(); ++j) {
+          out.q[j] = (out.q[j] - s.q[j]) + pcq[j];
+          out.v[j] = (out.v[j] - s.v[j]) + pcv[j];
+        }
+      }
+    };
+    if (lockstep_) {
+      // All products in lockstep (SplittingStepper::advance_lockstep): bitwise the same end states.
+      const std::size_t P = k_.size();
+      for (std::size_t r = 0; r < P; ++r) {
+        resize_like(products_[r].q, s.q);
+        resize_like(products_[r].v, s.v);
+        assign(products_[r].q, s.q);
+        assign(products_[r].v, s.v);
+        resize_like(pa_[r], s.q);
+        if (starts_with_kick_) assign(pa_[r], a0);
+        if constexpr (Comp) {
+          resize_like(pcq_[r], s.q);
+          resize_like(pcv_[r], s.q);
+          for (auto& e : pcq_[r]) e = scalar_type(0);
+          for (auto& e : pcv_[r]) e = scalar_type(0);
+        }
+      }
+      base_.template advance_lockstep<Comp>(P, products_.data(), pa_.data(), starts_with_kick_, scaled_.data(),
+                                            k_.data(), pcq_.data(), pcv_.data());
+      if constexpr (Comp) to_increments(P, s, products_, pcq_, pcv_);
+    } else if (concurrent_) {
+      run_concurrent<Comp>(s, a0);
+    } else {
+      // The products are independent: the reference one (largest k, the longest chain of dependent
+      // force evaluations) runs last, so that the processor overlaps the shorter ones with it.
+      for (std::size_t i = 0; i < k_.size(); ++i) {
+        if (i == ref_) continue;
+        std::conditional_t<local, State<V>, State<V>&> ti = products_[i];
+        product(i, ti);
+        if constexpr (local) products_[i] = ti;
+      }
+      std::conditional_t<local, State<V>, State<V>&> tref0 = products_[ref_];
+      product(ref_, tref0);
+      if constexpr (local) products_[ref_] = tref0;
+    }
+    combine<Comp>(k_.size(), s, comp, products_);
+  }
+
+  // n steps with K products of a fixed-size state in lockstep, everything in local arrays and the loop
+  // over the products unrolled (no store-to-load forwarding on the dependent chains). One function per
+  // K, not inlined into integrate, so that the force and the vector operations inline here.
+  template <bool Comp, std::size_t K>
+  void fixed_steps(State<V>& s, Compensator<V>& comp, long n) {
+    for (long i = 0; i < n; ++i) {
+      V a0{};
+      if (starts_with_kick_) {
+        base_.force()(s.q, a0);
+        ++extra_evals_;
+      }
+      fixed_step<Comp, K>(s, comp, a0);
+    }
+  }
+
+  // Calls fixed_steps<Comp, K> for K = the number of products; false if there are more than 8.
+  template <bool Comp>
+  bool dispatch_fixed(State<V>& s, Compensator<V>& comp, long n) {
+    if constexpr (is_std_array<V>::value) {
+      switch (k_.size()) {
+        case 1: fixed_steps<Comp, 1>(s, comp, n); return true;
+        case 2: fixed_steps<Comp, 2>(s, comp, n); return true;
+        case 3: fixed_steps<Comp, 3>(s, comp, n); return true;
+        case 4: fixed_steps<Comp, 4>(s, comp, n); return true;
+        case 5: fixed_steps<Comp, 5>(s, comp, n); return true;
+        case 6: fixed_steps<Comp, 6>(s, comp, n); return true;
+        case 7: fixed_steps<Comp, 7>(s, comp, n); return true;
+        case 8: fixed_steps<Comp, 8>(s, comp, n); return true;
+        default: return false;
+      }
+    } else {
+      (void)s, (void)comp, (void)n;
+      return false;
+    }
+  }
+
+  // One step of K products of a fixed-size state in lockstep, in local arrays.
+  template <bool Comp, std::size_t K>
+  NYSTROM_ALWAYS_INLINE void fixed_step(State<V>& s, Compensator<V>& comp, const V& a0) {
+    std::array<State<V>, K> x;
+    std::array<V, K> a{}, cq, cv;
+    for (std::size_t r = 0; r < K; ++r) {
+      x[r] = s;
+      if (starts_with_kick_) a[r] = a0;
+      if constexpr (Comp) {
+        cq[r].fill(scalar_type(0));
+        cv[r].fill(scalar_type(0));
       }
     }
+    base_.template advance_lockstep<Comp>(std::integral_constant<std::size_t, K>{}, x, a, starts_with_kick_,
+                                          scaled_.data(), k_.data(), cq, cv);
+    constexpr std::integral_constant<std::size_t, K> P{};
+    if constexpr (Comp) to_increments(P, s, x, cq, cv);
+    combine<Comp>(P, s, comp, x);
+  }
+
+  // Compensated products: T_r - s to full precision from the end state and its carries.
+  template <class Count, class TS, class CS>
+  NYSTROM_ALWAYS_INLINE static void to_increments(Count P, const State<V>& s, TS& T, const CS& cq, const CS& cv) {
+    SplittingStepper<V, Force>::for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
+      for (std::size_t j = 0; j < s.q.size(); ++j) {
+        T[r].q[j] = (T[r].q[j] - s.q[j]) + cq[r][j];
+        T[r].v[j] = (T[r].v[j] - s.v[j]) + cv[r][j];
+      }
+    });
+  }
+
+  // s <- T_ref + sum_{i != ref} c_i (T_i - T_ref) (T: end states), or with Comp s += the same
+  // combination of increments with the run's carry. P as in SplittingStepper::advance_lockstep: with an
+  // integral_constant the products are never indexed at run time (local arrays stay in registers).
+  template <bool Comp, class Count, class TS>
+  NYSTROM_ALWAYS_INLINE void combine(Count P, State<V>& s, Compensator<V>& comp, const TS& T) {
+    constexpr bool local = is_std_array<V>::value;
+    std::conditional_t<local, State<V>, State<V>&> acc = acc_, tref = tref_;
+    const std::size_t ref = ref_;
+    SplittingStepper<V, Force>::for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
+      if (r == ref) {
+        resize_like(tref.q, s.q);
+        resize_like(tref.v, s.v);
+        assign(tref.q, T[r].q);
+        assign(tref.v, T[r].v);
+      }
+    });
+    resize_like(acc.q, s.q);
+    resize_like(acc.v, s.q);
+    for (auto& e : acc.q) e = scalar_type(0);
+    for (auto& e : acc.v) e = scalar_type(0);
+    SplittingStepper<V, Force>::for_each_run(P, [&](std::size_t i) NYSTROM_ALWAYS_INLINE {
+      if (i == ref) return;
+      const State<V>& ti = T[i];
+      const scalar_type ci = c_[i];
+      for (std::size_t j = 0; j < s.q.size(); ++j) {
+        acc.q[j] += ci * (ti.q[j] - tref.q[j]);
+        acc.v[j] += ci * (ti.v[j] - tref.v[j]);
+      }
+    });
     if constexpr (Comp) {
       for (std::size_t j = 0; j < s.q.size(); ++j) {
-        acc_.q[j] += tref_.q[j];
-        acc_.v[j] += tref_.v[j];
+        acc.q[j] += tref.q[j];
+        acc.v[j] += tref.v[j];
       }
-      comp_.add_q(s.q, acc_.q);
-      comp_.add_v(s.v, acc_.v);
+      comp.add_q(s.q, acc.q);
+      comp.add_v(s.v, acc.v);
     } else {
       for (std::size_t j = 0; j < s.q.size(); ++j) {
-        s.q[j] = tref_.q[j] + acc_.q[j];
-        s.v[j] = tref_.v[j] + acc_.v[j];
+        s.q[j] = tref.q[j] + acc.q[j];
+        s.v[j] = tref.v[j] + acc.v[j];
       }
     }
     if (is_complex_v<scalar_type> && !opt_.keep_complex) {
       project_real(s.q);
       project_real(s.v);
       if constexpr (Comp) {
-        project_real(comp_.cq);
-        project_real(comp_.cv);
+        project_real(comp.cq);
+        project_real(comp.cv);
       }
     }
   }
 
+  // The products on OpenMP threads, each on its own copy of the base (force functor, counter); the
+  // same operations per product as the sequential schedule, so bitwise the same results.
+  template <bool Comp>
+  void run_concurrent(const State<V>& s, const V& a0) {
+    const std::size_t m = base_.scheme().steps.size();
+    const long P = static_cast<long>(k_.size());
+    const int threads = opt_.mpe_threads > 0 ? opt_.mpe_threads : max_threads();
+    std::exception_ptr error;
+    (void)threads;
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (threads > 1)
+#endif
+    for (long idx = 0; idx < P; ++idx) {
+      const std::size_t r = order_[static_cast<std::size_t>(idx)];
+      try {
+        State<V>& out = products_[r];
+        resize_like(out.q, s.q);
+        resize_like(out.v, s.v);
+        assign(out.q, s.q);
+        assign(out.v, s.v);
+        resize_like(pa_[r], s.q);
+        bool valid = starts_with_kick_;
+        if (valid) assign(pa_[r], a0);
+        if constexpr (Comp) {
+          resize_like(pcq_[r], s.q);
+          resize_like(pcv_[r], s.q);
+          for (auto& e : pcq_[r]) e = scalar_type(0);
+          for (auto& e : pcv_[r]) e = scalar_type(0);
+        }
+        workers_[r].template advance_scaled<Comp>(out, pa_[r], valid, scaled_.data() + r * m, k_[r], pcq_[r], pcv_[r]);
+        if constexpr (Comp) {
+          for (std::size_t j = 0; j < s.q.size(); ++j) {
+            out.q[j] = (out.q[j] - s.q[j]) + pcq_[r][j];
+            out.v[j] = (out.v[j] - s.v[j]) + pcv_[r][j];
+          }
+        }
+      } catch (...) {
+#ifdef _OPENMP
+#pragma omp critical(nystrom_mpe_error)
+#endif
+        if (!error) error = std::current_exception();
+      }
+    }
+    if (error) std::rethrow_exception(error);
+  }
+
+  static int max_threads() {
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+  }
+
+  // Measurements only (naive_step): one product T_2^k_i(h / k_i) from s.
   template <bool Comp>
   void run_product(const State<V>& s, std::size_t i, real_type h, State<V>& out) {
     resize_like(out.q, s.q);
@@ -265,8 +522,14 @@ class MpeStepper {
   std::size_t ref_ = 0;
   bool starts_with_kick_ = false;
   long extra_evals_ = 0;
-  V a0_{};
-  State<V> tref_{}, ti_{}, acc_{};
+  V a0_{}, a_{};
+  State<V> ti_{}, acc_{}, tref_{};
+  std::vector<State<V>> products_;        // T_2^k_i(h / k_i) of the current step (or its increment)
+  bool lockstep_ = false, concurrent_ = false;
+  std::vector<SplittingStepper<V, Force>> workers_;  // concurrent: a copy of the base per product
+  std::vector<std::size_t> order_;                   // concurrent: products by decreasing k
+  std::vector<V> pa_, pcq_, pcv_;  // lockstep: each product's force cache and carries
+  std::vector<scalar_type> scaled_, hc_;  // base coefficients times h / k_i, product after product
   Compensator<V> comp_, pc_;
 };
 

@@ -14,10 +14,19 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "nystrom/core/state.hpp"
+
+#ifndef NYSTROM_ALWAYS_INLINE
+#if defined(__GNUC__) || defined(__clang__)
+#define NYSTROM_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define NYSTROM_ALWAYS_INLINE
+#endif
+#endif
 
 namespace nystrom {
 
@@ -101,12 +110,23 @@ class RknStepper {
 
   void integrate(State<V>& s, real_type h, long n) {
     if (n <= 0) return;
+    // A fixed-size state (and carry) is copied into a local for the loop (one_step is inlined here):
+    // the caller's state could alias this object's members as far as the compiler knows, which would
+    // force stores and reloads around every stage; a local stays in registers.
+    constexpr bool local = is_std_array<V>::value;
+    std::conditional_t<local, State<V>, State<V>&> x = s;
     if (use_compensation<scalar_type>(opt_.compensated)) {
       comp_.begin(s);
-      for (long k = 0; k < n; ++k) one_step(s, h, nullptr, &comp_);
+      std::conditional_t<local, Compensator<V>, Compensator<V>&> c = comp_;
+      for (long k = 0; k < n; ++k) one_step(x, h, nullptr, &c);
+      if constexpr (local) {
+        s = x;
+        comp_ = c;
+      }
       comp_.end(s);
     } else {
-      for (long k = 0; k < n; ++k) one_step(s, h, nullptr, nullptr);
+      for (long k = 0; k < n; ++k) one_step(x, h, nullptr, nullptr);
+      if constexpr (local) s = x;
     }
   }
 
@@ -120,11 +140,14 @@ class RknStepper {
     scalar_type a;
   };
 
-  void one_step(State<V>& st, real_type hr, State<V>* err, Compensator<V>* comp) {
+  NYSTROM_ALWAYS_INLINE void one_step(State<V>& st, real_type hr, State<V>* err, Compensator<V>* comp) {
     const std::size_t s = t_.stages();
     const scalar_type h(hr), h2 = h * h;
     for (auto& f : f_) resize_like(f, st.q);
     resize_like(y_, st.q);
+    // The stage position and the increments: locals if fixed-size (see integrate).
+    constexpr bool local = is_std_array<V>::value;
+    std::conditional_t<local, V, V&> y = y_, dq = dq_, dv = dv_;
     const bool project = is_complex_v<scalar_type> && !opt_.keep_complex;
     std::size_t k = 0;  // index into nz_, ordered by stage
     for (std::size_t i = 0; i < s; ++i) {
@@ -132,10 +155,10 @@ class RknStepper {
         while (k < nz_.size() && nz_[k].i == 0) ++k;
         continue;  // f_[0] already holds the force at q_n
       }
-      assign(y_, st.q);
-      if (!(t_.c[i] == scalar_type(0))) axpy(y_, t_.c[i] * h, st.v);
-      for (; k < nz_.size() && nz_[k].i == i; ++k) axpy(y_, nz_[k].a * h2, f_[nz_[k].j]);
-      force_(y_, f_[i]);
+      assign(y, st.q);
+      if (!(t_.c[i] == scalar_type(0))) axpy(y, t_.c[i] * h, st.v);
+      for (; k < nz_.size() && nz_[k].i == i; ++k) axpy(y, nz_[k].a * h2, f_[nz_[k].j]);
+      force_(y, f_[i]);
       ++evals_;
     }
     if (err) {
@@ -151,19 +174,19 @@ class RknStepper {
     }
     if (comp) {
       // One increment per step for q and for v, added with compensation.
-      resize_like(dq_, st.q);
-      resize_like(dv_, st.q);
+      resize_like(dq, st.q);
+      resize_like(dv, st.q);
       for (std::size_t j = 0; j < st.q.size(); ++j) {
-        dq_[j] = scalar_type(0);
-        dv_[j] = scalar_type(0);
+        dq[j] = scalar_type(0);
+        dv[j] = scalar_type(0);
       }
       for (std::size_t i = 0; i < s; ++i)
-        if (!(t_.b[i] == scalar_type(0))) axpy(dq_, t_.b[i] * h2, f_[i]);
-      axpy(dq_, h, st.v);
+        if (!(t_.b[i] == scalar_type(0))) axpy(dq, t_.b[i] * h2, f_[i]);
+      axpy(dq, h, st.v);
       for (std::size_t i = 0; i < s; ++i)
-        if (!(t_.B[i] == scalar_type(0))) axpy(dv_, t_.B[i] * h, f_[i]);
-      comp->add_q(st.q, dq_);
-      comp->add_v(st.v, dv_);
+        if (!(t_.B[i] == scalar_type(0))) axpy(dv, t_.B[i] * h, f_[i]);
+      comp->add_q(st.q, dq);
+      comp->add_v(st.v, dv);
     } else {
       axpy(st.q, h, st.v);
       for (std::size_t i = 0; i < s; ++i)

@@ -15,13 +15,23 @@
 //     (Gürkan, sec. 5) unless keep_complex is set.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "nystrom/core/state.hpp"
+
+#ifndef NYSTROM_ALWAYS_INLINE
+#if defined(__GNUC__) || defined(__clang__)
+#define NYSTROM_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define NYSTROM_ALWAYS_INLINE
+#endif
+#endif
 
 namespace nystrom {
 
@@ -94,6 +104,8 @@ class SplittingStepper {
     if (scheme_.steps.empty()) throw std::invalid_argument("splitting scheme has no sub-steps");
     for (const auto& s : scheme_.steps)
       if (!is_finite_scalar(s.coef)) throw std::invalid_argument("splitting coefficient is not finite");
+    const auto& st = scheme_.steps;
+    merged_ = !project_ && st.size() > 1 && st.front().flow == st.back().flow;
   }
 
   const SplittingScheme<scalar_type>& scheme() const { return scheme_; }
@@ -131,63 +143,255 @@ class SplittingStepper {
     if (n > 0) run<true>(s, h, n, c);
   }
 
- private:
+  /// hc[i] = coefficient i times h, in the order of application (the input of advance_scaled).
+  void scale_coefficients(real_type h, std::vector<scalar_type>& hc) const {
+    const auto& st = scheme_.steps;
+    hc.resize(st.size());
+    for (std::size_t i = 0; i < st.size(); ++i) hc[i] = st[i].coef * scalar_type(h);
+  }
+
+  /// The loop of integrate() on a state x and force cache a held by the caller, with the coefficients
+  /// already multiplied by the step size (scale_coefficients): n steps. `valid` says whether a is the
+  /// force at x.q and is updated; the force evaluations are counted; the stepper's own cache is not
+  /// touched. With Comp, the updates are compensated with the carries cq, cv (else those are unused).
+  /// For engines built on this one (MpeStepper), which keep x, a and the carries in locals.
+  template <bool Comp>
+  NYSTROM_ALWAYS_INLINE void advance_scaled(State<V>& x, V& a, bool& valid, const scalar_type* hc, long n, V& cq,
+                                            V& cv) {
+    if (n <= 0) return;
+    if (!merged_) {
+      advance_sequential<Comp>(x, a, valid, hc, n, cq, cv);
+      return;
+    }
+    auto drift = [&](const scalar_type& c) NYSTROM_ALWAYS_INLINE {
+      if constexpr (Comp) {
+        for (std::size_t j = 0; j < x.q.size(); ++j) compensated_add(x.q[j], cq[j], scalar_type(c * x.v[j]));
+      } else {
+        axpy(x.q, c, x.v);
+      }
+    };
+    auto kick = [&](const scalar_type& c) NYSTROM_ALWAYS_INLINE {
+      if constexpr (Comp) {
+        for (std::size_t j = 0; j < x.v.size(); ++j) compensated_add(x.v[j], cv[j], scalar_type(c * a[j]));
+      } else {
+        axpy(x.v, c, a);
+      }
+    };
+    long evals = 0;
+    const auto& st = scheme_.steps;
+    const std::size_t m = st.size();
+    // Merged steps. After normalization drifts and kicks alternate (m is odd, the first and last
+    // sub-steps are of the same flow), so the n steps run as n (m - 1) / 2 pairs of sub-steps of known
+    // flows and then the last sub-step: every kick follows a drift and evaluates the force, except a
+    // first kick that finds a valid cached force. The same operations in the same order as sub-step by
+    // sub-step, but without a branch on the flow and with a single force call in the loop (so that the
+    // compiler inlines it and keeps the state in registers).
+    const bool kick_first = st.front().flow == Flow::kick;
+    const scalar_type joined = hc[m - 1] + hc[0];
+    const long pairs = n * static_cast<long>((m - 1) / 2);
+    scalar_type first = hc[0];  // the coefficient that starts a step: hc[0], then the merged one
+    std::size_t i = 0;          // position of the pair in the step
+    for (long p = 0; p < pairs; ++p) {
+      const scalar_type& c0 = i == 0 ? first : hc[i];
+      if (!kick_first) drift(c0);
+      if (!(kick_first && p == 0 && valid)) {
+        force_(x.q, a);
+        ++evals;
+      }
+      kick(kick_first ? c0 : hc[i + 1]);
+      if (kick_first) drift(hc[i + 1]);
+      i += 2;
+      if (i + 1 >= m) {
+        i = 0;
+        first = joined;
+      }
+    }
+    if (kick_first) {
+      force_(x.q, a);
+      ++evals;
+      kick(hc[m - 1]);
+    } else {
+      drift(hc[m - 1]);
+    }
+    valid = kick_first;
+    evals_ += evals;
+  }
+
+  /// Whether advance_lockstep can run this scheme (the last sub-step of a step merges with the first
+  /// of the next, which every symmetric base of the multi-product engine does).
+  bool lockstep_capable() const { return merged_; }
+
+  // f(r) for r = 0 .. P - 1: a run-time loop, or unrolled when P is an integral_constant.
+  template <class Count, class Fn>
+  NYSTROM_ALWAYS_INLINE static void for_each_run(Count P, Fn&& f) {
+    if constexpr (std::is_integral_v<Count>) {
+      for (std::size_t r = 0; r < P; ++r) f(r);
+    } else {
+      [&]<std::size_t... R>(std::index_sequence<R...>) NYSTROM_ALWAYS_INLINE { (f(R), ...); }
+      (std::make_index_sequence<Count::value>{});
+    }
+  }
+
+  /// P independent runs advanced in lockstep: run r starts from x[r] (force cache a[r], valid when
+  /// kick_valid and the scheme starts with a kick), makes n[r] steps with the coefficients hc + r m
+  /// (scale_coefficients, m sub-steps), and carries cq[r], cv[r] with Comp. Sub-step pair j of every
+  /// run comes before pair j + 1 of any run, so that the processor overlaps the independent chains of
+  /// dependent force evaluations (the critical path of the MPE {1,2,3,4} is 4 forces, not 10). Each run
+  /// performs exactly the operations of advance_scaled in the same order: the results are bitwise
+  /// those of running them one after the other. Requires lockstep_capable().
+  /// x, a, cq, cv: pointers or arrays (local arrays of fixed-size states stay in registers); P: a
+  /// run-time count or a std::integral_constant, which unrolls the loop over the runs.
+  template <bool Comp, class Count, class XS, class AS, class CS>
+  NYSTROM_ALWAYS_INLINE void advance_lockstep(Count P, XS&& x, AS&& a, bool kick_valid, const scalar_type* hc,
+                                              const long* n, CS&& cq, CS&& cv) {
+    const auto& st = scheme_.steps;
+    const std::size_t m = st.size();
+    const long half = static_cast<long>((m - 1) / 2);  // sub-step pairs per step
+    const bool kick_first = st.front().flow == Flow::kick;
+    long max_pairs = 0;
+    for_each_run(P, [&](std::size_t r) { max_pairs = std::max(max_pairs, n[r] * half); });
+    long evals = 0;
+    std::size_t i = 0;  // position of the pair in the step: the same for every run
+    for (long p = 0; p < max_pairs; ++p) {
+      for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
+        if (p >= n[r] * half) return;
+        const scalar_type* c = hc + r * m;
+        State<V>& y = x[r];
+        V& ar = a[r];
+        // The first sub-step of a step after the first joins the previous step's last one.
+        const scalar_type c0 = i == 0 ? (p == 0 ? c[0] : scalar_type(c[m - 1] + c[0])) : c[i];
+        if (!kick_first) {
+          if constexpr (Comp) {
+            for (std::size_t j = 0; j < y.q.size(); ++j) compensated_add(y.q[j], cq[r][j], scalar_type(c0 * y.v[j]));
+          } else {
+            axpy(y.q, c0, y.v);
+          }
+        }
+        if (!(kick_first && p == 0 && kick_valid)) {
+          force_(y.q, ar);
+          ++evals;
+        }
+        const scalar_type& ck = kick_first ? c0 : c[i + 1];
+        if constexpr (Comp) {
+          for (std::size_t j = 0; j < y.v.size(); ++j) compensated_add(y.v[j], cv[r][j], scalar_type(ck * ar[j]));
+        } else {
+          axpy(y.v, ck, ar);
+        }
+        if (kick_first) {
+          if constexpr (Comp) {
+            for (std::size_t j = 0; j < y.q.size(); ++j)
+              compensated_add(y.q[j], cq[r][j], scalar_type(c[i + 1] * y.v[j]));
+          } else {
+            axpy(y.q, c[i + 1], y.v);
+          }
+        }
+      });
+      i += 2;
+      if (i + 1 >= m) i = 0;
+    }
+    // The last sub-step of every run.
+    for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
+      if (n[r] <= 0) return;
+      const scalar_type* c = hc + r * m;
+      State<V>& y = x[r];
+      if (kick_first) {
+        force_(y.q, a[r]);
+        ++evals;
+        if constexpr (Comp) {
+          for (std::size_t j = 0; j < y.v.size(); ++j) compensated_add(y.v[j], cv[r][j], scalar_type(c[m - 1] * a[r][j]));
+        } else {
+          axpy(y.v, c[m - 1], a[r]);
+        }
+      } else {
+        if constexpr (Comp) {
+          for (std::size_t j = 0; j < y.q.size(); ++j) compensated_add(y.q[j], cq[r][j], scalar_type(c[m - 1] * y.v[j]));
+        } else {
+          axpy(y.q, c[m - 1], y.v);
+        }
+      }
+    });
+    evals_ += evals;
+  }
+
+  /// Sub-steps one after the other: schemes whose steps do not merge, and complex schemes whose state is
+  /// projected to real after every step (the arguments as for advance_scaled).
+  template <bool Comp>
+  void advance_sequential(State<V>& s, V& a_io, bool& valid_io, const scalar_type* hc, long n, V& cq_io, V& cv_io) {
+    constexpr bool local = is_std_array<V>::value;  // see run()
+    std::conditional_t<local, State<V>, State<V>&> x = s;
+    std::conditional_t<local, V, V&> a = a_io, cq = cq_io, cv = cv_io;
+    bool valid = valid_io;
+    long evals = 0;
+    const auto& st = scheme_.steps;
+    for (long k = 0; k < n; ++k) {
+      for (std::size_t i = 0; i < st.size(); ++i) {
+        if (st[i].flow == Flow::drift) {
+          if constexpr (Comp) {
+            for (std::size_t j = 0; j < x.q.size(); ++j) compensated_add(x.q[j], cq[j], scalar_type(hc[i] * x.v[j]));
+          } else {
+            axpy(x.q, hc[i], x.v);
+          }
+          valid = false;
+        } else {
+          if (!valid) {
+            force_(x.q, a);
+            ++evals;
+            valid = true;
+          }
+          if constexpr (Comp) {
+            for (std::size_t j = 0; j < x.v.size(); ++j) compensated_add(x.v[j], cv[j], scalar_type(hc[i] * a[j]));
+          } else {
+            axpy(x.v, hc[i], a);
+          }
+        }
+      }
+      if (project_) {
+        project_real(x.q);
+        project_real(x.v);
+        if constexpr (Comp) {
+          project_real(cq);
+          project_real(cv);
+        }
+        valid = false;
+      }
+    }
+    if constexpr (local) {
+      s = x;
+      a_io = a;
+      if constexpr (Comp) {
+        cq_io = cq;
+        cv_io = cv;
+      }
+    }
+    valid_io = valid;
+    evals_ += evals;
+  }
+
   template <bool Comp>
   void run(State<V>& s, real_type h, long n, Compensator<V>& c) {
     resize_like(a_, s.q);
     check_cache(s.q);
-    const auto& st = scheme_.steps;
-    const std::size_t m = st.size();
-    hc_.resize(m);
-    for (std::size_t i = 0; i < m; ++i) hc_[i] = st[i].coef * scalar_type(h);
-    const bool project = is_complex_v<scalar_type> && !opt_.keep_complex;
-    const bool merge = !project && m > 1 && st.front().flow == st.back().flow;
-    if (!merge) {
-      for (long k = 0; k < n; ++k) {
-        for (std::size_t i = 0; i < m; ++i) apply<Comp>(s, st[i].flow, hc_[i], c);
-        if (project) {
-          project_real(s.q);
-          project_real(s.v);
-          if constexpr (Comp) {
-            project_real(c.cq);
-            project_real(c.cv);
-          }
-          cache_valid_ = false;
-        }
+    scale_coefficients(h, hc_);
+    // A fixed-size state, force cache and carry are copied into locals for the loop: the caller's
+    // state and this object's members could alias as far as the compiler knows, which would force a
+    // store and a reload around every sub-step; locals (whose address never escapes) stay in registers.
+    constexpr bool local = is_std_array<V>::value;
+    std::conditional_t<local, State<V>, State<V>&> x = s;
+    std::conditional_t<local, V, V&> a = a_, cq = c.cq, cv = c.cv;
+    bool valid = cache_valid_;
+    advance_scaled<Comp>(x, a, valid, hc_.data(), n, cq, cv);
+    if constexpr (local) {
+      s = x;
+      a_ = a;
+      if constexpr (Comp) {
+        c.cq = cq;
+        c.cv = cv;
       }
-      remember(s.q);
-      return;
     }
-    const scalar_type joined = hc_[m - 1] + hc_[0];
-    for (std::size_t i = 0; i + 1 < m; ++i) apply<Comp>(s, st[i].flow, hc_[i], c);
-    for (long k = 1; k < n; ++k) {
-      apply<Comp>(s, st[0].flow, joined, c);
-      for (std::size_t i = 1; i + 1 < m; ++i) apply<Comp>(s, st[i].flow, hc_[i], c);
-    }
-    apply<Comp>(s, st[m - 1].flow, hc_[m - 1], c);
+    cache_valid_ = valid;
     remember(s.q);
   }
 
-  template <bool Comp>
-  void apply(State<V>& s, Flow f, const scalar_type& c, Compensator<V>& comp) {
-    if (f == Flow::drift) {
-      if constexpr (Comp)
-        comp.axpy_q(s.q, c, s.v);
-      else
-        axpy(s.q, c, s.v);
-      cache_valid_ = false;
-    } else {
-      if (!cache_valid_) {
-        force_(s.q, a_);
-        ++evals_;
-        cache_valid_ = true;
-      }
-      if constexpr (Comp)
-        comp.axpy_v(s.v, c, a_);
-      else
-        axpy(s.v, c, a_);
-    }
-  }
   // The cache survives between calls only if the caller did not move q.
   void check_cache(const V& q) {
     if (!cache_valid_) return;
@@ -211,6 +415,8 @@ class SplittingStepper {
   SplittingScheme<scalar_type> scheme_;
   Force force_;
   EngineOptions opt_;
+  bool project_ = is_complex_v<scalar_type> && !opt_.keep_complex;  // drop imaginary parts after each step
+  bool merged_ = false;  // the last sub-step of a step merges with the first of the next
   Compensator<V> comp_;
   V a_{};
   V aq_{};
