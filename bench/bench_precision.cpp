@@ -7,11 +7,17 @@
 // The engine is the same generic code in every case (make_integrator<std::array<T, 2>>); only the
 // scalar type differs. One benchmark iteration integrates a batch of kSteps steps from the apocentre
 // (h = 2 pi / kSteps, one period per batch), the state reset every iteration.
+// The baseline is double without compensated summation, like every wider type (the library's
+// default compensates float and double only: EngineOptions::compensated); the default double,
+// compensated, is listed as well ("double+comp").
 //
 // Before benchmarking, every precision's final state after one period is checked against double's
 // (same method and step, so they must agree to double's rounding). After the run, a table gives the
 // CPU time per step (minimum over repetitions, robust on a shared machine) and the ratio to double.
-// Target (the issue): double-double at most 10x double per step.
+// Target (the issue): double-double at most 10x double per step. Double-double multiplication needs
+// an exact product a*b = p + e: with hardware FMA (built with -march=native, CMake option
+// NYSTROM_NATIVE) that is two instructions, without it Dekker's splitting (17 flops); the summary says
+// which one this build uses.
 //
 //   bench_precision --benchmark_repetitions=5     (the default here: 5 repetitions, 0.2 s each)
 #include <benchmark/benchmark.h>
@@ -38,7 +44,8 @@ constexpr long kSteps = 2000;  // per batch: one period at h = 2 pi / 2000
 const char* const kMethod = "M8";
 
 const std::vector<std::string>& precisions() {
-  static const std::vector<std::string> p{"double", "long-double", "float128", "dd", "qd", "mpfr:113", "mpfr:256"};
+  static const std::vector<std::string> p{"double", "double+comp", "long-double", "float128", "dd", "qd", "mpfr:113",
+                                          "mpfr:256"};
   return p;
 }
 
@@ -52,9 +59,12 @@ std::array<double, 4> one_period() {
 }
 
 void bm_precision(benchmark::State& state, const std::string& precision) {
-  dispatch_precision(precision, [&](auto tag) {
+  const bool comp = precision == "double+comp";
+  dispatch_precision(comp ? std::string("double") : precision, [&](auto tag) {
     using T = typename decltype(tag)::type;
-    auto integ = make_integrator<std::array<T, 2>>(resolve_method(kMethod), KeplerForce{});
+    EngineOptions opt;
+    opt.compensated = comp ? Compensation::on : Compensation::off;
+    auto integ = make_integrator<std::array<T, 2>>(resolve_method(kMethod), KeplerForce{}, opt);
     const KeplerProblem<T> prob{T(kEcc)};
     const auto s0 = prob.initial_state();
     const T h = KeplerProblem<T>::period() / T(kSteps);
@@ -72,6 +82,7 @@ bool check_agreement() {
   const auto ref = one_period<double>();
   bool ok = true;
   for (const auto& p : precisions()) {
+    if (p == "double+comp") continue;
     const auto x = dispatch_precision(p, [](auto tag) { return one_period<typename decltype(tag)::type>(); });
     double diff = 0;
     for (int k = 0; k < 4; ++k) diff = std::max(diff, std::abs(x[k] - ref[k]));
@@ -100,6 +111,11 @@ class SummaryReporter : public benchmark::ConsoleReporter {
   void summary() const {
     std::printf("\n%s on Kepler e = %.1f, %ld steps per batch; minimum over repetitions of CPU time per step\n", kMethod,
                 kEcc, kSteps);
+#ifdef __FMA__
+    std::printf("built with hardware FMA: double-double products by fma\n");
+#else
+    std::printf("built without FMA: double-double products by Dekker's splitting (see NYSTROM_NATIVE)\n");
+#endif
     const auto base = best_.find("M8/double");
     std::printf("%-12s %12s %10s\n", "precision", "ns/step", "/ double");
     for (const auto& p : precisions()) {

@@ -54,6 +54,7 @@
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/methods/method.hpp"
+#include "nystrom/methods/refine.hpp"
 
 namespace nystrom {
 
@@ -313,8 +314,8 @@ template <class V, class F>
 AdaptiveRknIntegrator<V, F> make_adaptive_integrator(const MethodDef& def, F force, AdaptiveOptions opt = {}) {
   using S = typename V::value_type;
   opt.validate();
-  BigPrecision guard(reference_bits(scalar_traits<S>::bits()));
-  const MethodData data = def.build();
+  // Coefficients at the reference precision; the working values are created outside it (mpfr_real).
+  const MethodData data = method_data_for(def, scalar_traits<S>::bits(), scalar_traits<S>::name());
   const auto* t = std::get_if<RknTableau<bigcomplex>>(&data);
   if (!t || t->bhat.empty())
     throw std::invalid_argument("method '" + def.info.name + "' has no embedded pair: it cannot run with a tolerance");
