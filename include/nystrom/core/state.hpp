@@ -15,6 +15,15 @@
 
 #include "nystrom/core/scalar.hpp"
 
+// Forces inlining of the engines' inner steps (the hot loops keep fixed-size states in registers).
+#ifndef NYSTROM_ALWAYS_INLINE
+#if defined(__GNUC__) || defined(__clang__)
+#define NYSTROM_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define NYSTROM_ALWAYS_INLINE
+#endif
+#endif
+
 namespace nystrom {
 
 /// Compensated (Kahan/Knuth two-sum) summation of the position and velocity updates.

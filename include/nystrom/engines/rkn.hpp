@@ -20,14 +20,6 @@
 
 #include "nystrom/core/state.hpp"
 
-#ifndef NYSTROM_ALWAYS_INLINE
-#if defined(__GNUC__) || defined(__clang__)
-#define NYSTROM_ALWAYS_INLINE __attribute__((always_inline))
-#else
-#define NYSTROM_ALWAYS_INLINE
-#endif
-#endif
-
 namespace nystrom {
 
 template <class C>
