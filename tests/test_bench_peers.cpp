@@ -1,0 +1,254 @@
+// `nystrom bench-peers --quick`: the work-precision comparison against Boost.Odeint runs, writes its
+// files, and its numbers hold together (force counts, convergence at each method's order, nystrom
+// reaching 1e-12 at e = 0.9, compensated summation lowering the round-off floor). No timing assertions.
+// The tool is found through NYSTROM_BIN (set by CTest).
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "nystrom/methods/catalog.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string tool() {
+  const char* b = std::getenv("NYSTROM_BIN");
+  return b ? b : "nystrom";
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+int shell(const std::string& cmd) {
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+bool have_gnuplot() { return shell("command -v gnuplot >/dev/null 2>&1") == 0; }
+
+/// One quick run shared by all tests.
+class BenchPeers : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / ("nystrom-peers-" + std::to_string(::getpid())));
+    fs::create_directories(*dir_);
+    const auto out = *dir_ / "stdout.txt", err = *dir_ / "stderr.txt";
+    code_ = shell(tool() + " bench-peers --quick --out " + dir_->string() + " >" + out.string() + " 2>" + err.string() +
+                  " </dev/null");
+    stdout_ = new std::string(slurp(out));
+    stderr_ = new std::string(slurp(err));
+    const fs::path jp = *dir_ / "peers.json";
+    j_ = new json(fs::exists(jp) ? json::parse(slurp(jp), nullptr, false) : json());
+  }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(*dir_, ec);
+    delete dir_;
+    delete stdout_;
+    delete stderr_;
+    delete j_;
+  }
+  void SetUp() override {
+    ASSERT_EQ(code_, 0) << *stderr_;
+    ASSERT_TRUE(j_->is_object()) << "peers.json missing or not JSON";
+  }
+  static std::vector<json> runs_of(const std::string& label, double ecc) {
+    std::vector<json> v;
+    for (const auto& r : (*j_)["runs"])
+      if (r["label"] == label && r["ecc"].get<double>() == ecc) v.push_back(r);
+    return v;
+  }
+  static inline fs::path* dir_ = nullptr;
+  static inline int code_ = -1;
+  static inline std::string* stdout_ = nullptr;
+  static inline std::string* stderr_ = nullptr;
+  static inline json* j_ = nullptr;
+};
+
+const std::vector<std::string> kNystromFixed{"VV", "M4", "M6", "M6-5F", "A6", "M8", "KL8", "M10", "SS10", "M12", "DP12"};
+const std::vector<std::string> kOdeintFixed{"odeint velocity_verlet", "odeint sb3a_mclachlan", "odeint sb3a_m4_mclachlan",
+                                            "odeint rkf78"};
+const std::vector<std::string> kAdaptive{"DP12-adaptive", "GBS", "odeint dopri5", "odeint bulirsch_stoer"};
+
+}  // namespace
+
+TEST_F(BenchPeers, FilesExistAndParse) {
+  const std::string csv = slurp(*dir_ / "peers_runs.csv");
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.rfind("library,method,", 0), 0u);
+  std::size_t rows = 0;
+  while (std::getline(in, line))
+    if (!line.empty()) ++rows;
+  EXPECT_EQ(rows, (*j_)["runs"].size());
+  EXPECT_GT(rows, 200u);
+  if (have_gnuplot())
+    for (const char* e : {"0.5", "0.9"})
+      for (const char* kind : {"forces", "time"}) {
+        const fs::path png = *dir_ / (std::string("peers_") + kind + "_e" + e + ".png");
+        ASSERT_TRUE(fs::exists(png)) << png;
+        EXPECT_EQ(slurp(png).substr(1, 3), "PNG");
+      }
+  EXPECT_NE(stdout_->find("fastest run reaching each target error"), std::string::npos);
+}
+
+TEST_F(BenchPeers, EveryMethodRanAtBothEccentricities) {
+  std::vector<std::string> all = kNystromFixed;
+  all.insert(all.end(), kOdeintFixed.begin(), kOdeintFixed.end());
+  all.insert(all.end(), kAdaptive.begin(), kAdaptive.end());
+  for (const char* n : {"M8 (no comp.)", "SS10 (no comp.)", "DP12 (no comp.)"}) all.push_back(n);
+  for (double e : {0.5, 0.9})
+    for (const auto& label : all) {
+      int ok = 0;
+      for (const auto& r : runs_of(label, e)) ok += r["ok"].get<bool>();
+      EXPECT_GE(ok, 3) << label << " at e = " << e;
+    }
+}
+
+// Fixed-step methods: force evaluations = steps x forces per step (+ 1 for the first step of an FSAL
+// method), counted by the one functor both libraries call; for nystrom the per-step count is the
+// catalog's.
+TEST_F(BenchPeers, FixedStepForceCountsAreStepsTimesForcesPerStep) {
+  for (const auto& name : kNystromFixed) {
+    const auto info = nystrom::resolve_method(name).info;
+    for (double e : {0.5, 0.9})
+      for (const auto& r : runs_of(name, e)) {
+        EXPECT_EQ(r["forces_per_step"].get<int>(), info.forces_per_step) << name;
+        EXPECT_EQ(r["forces"].get<long>(), r["steps"].get<long>() * info.forces_per_step + (info.fsal ? 1 : 0))
+            << name << " at " << r["param"];
+      }
+  }
+  const std::map<std::string, std::pair<int, int>> odeint{{"odeint velocity_verlet", {1, 1}},
+                                                          {"odeint sb3a_mclachlan", {6, 0}},
+                                                          {"odeint sb3a_m4_mclachlan", {5, 0}},
+                                                          {"odeint rkf78", {13, 0}}};
+  for (const auto& [label, fe] : odeint)
+    for (double e : {0.5, 0.9})
+      for (const auto& r : runs_of(label, e))
+        EXPECT_EQ(r["forces"].get<long>(), r["steps"].get<long>() * fe.first + fe.second) << label;
+  // The steps are those asked for: steps per period x periods.
+  for (const auto& r : (*j_)["runs"])
+    if (!r["adaptive"].get<bool>()) {
+      EXPECT_EQ(r["steps"].get<long>(), std::lround(r["param"].get<double>()) * (*j_)["periods"].get<long>());
+    }
+}
+
+// At e = 0.5 every fixed-step method converges at its order: errors fall strictly with the step count
+// between 1e-3 and 1e-10, and the fitted slope is near the order.
+TEST_F(BenchPeers, FixedStepErrorsFallAtTheOrder) {
+  std::vector<std::string> all = kNystromFixed;
+  all.insert(all.end(), kOdeintFixed.begin(), kOdeintFixed.end());
+  for (const auto& label : all) {
+    const auto runs = runs_of(label, 0.5);
+    double prev = INFINITY;
+    int used = 0;
+    for (const auto& r : runs) {
+      const double err = r["error"].is_null() ? INFINITY : r["error"].get<double>();
+      if (err > 1e-3 || err < 1e-10) continue;
+      EXPECT_LT(err, prev) << label << " at " << r["param"] << " steps per period";
+      prev = err;
+      ++used;
+    }
+    EXPECT_GE(used, 2) << label;
+    for (const auto& m : (*j_)["methods"])
+      if (m["label"] == label && m["ecc"].get<double>() == 0.5) {
+        ASSERT_FALSE(m["observed_order"].is_null()) << label;
+        const double p = m["observed_order"].get<double>(), order = m["order"].get<double>();
+        EXPECT_GT(p, 0.8 * order) << label;
+        EXPECT_LT(p, 1.6 * order + 0.5) << label;
+      }
+  }
+}
+
+// Adaptive methods: tighter tolerances cost more and end closer.
+TEST_F(BenchPeers, AdaptiveTighterToleranceCostsMoreAndGetsCloser) {
+  for (const auto& label : kAdaptive)
+    for (double e : {0.5, 0.9}) {
+      std::vector<json> ok;
+      for (const auto& r : runs_of(label, e))
+        if (r["ok"].get<bool>()) ok.push_back(r);
+      ASSERT_GE(ok.size(), 3u) << label;
+      EXPECT_LT(ok.back()["param"].get<double>(), ok.front()["param"].get<double>());
+      EXPECT_GT(ok.back()["forces"].get<long>(), 2 * ok.front()["forces"].get<long>()) << label << " e=" << e;
+      EXPECT_LT(ok.back()["error"].get<double>(), 1e-4 * ok.front()["error"].get<double>()) << label << " e=" << e;
+    }
+}
+
+TEST_F(BenchPeers, NystromReaches1e12AtEccentricity09) {
+  bool found = false;
+  for (const auto& t : (*j_)["targets"])
+    if (t["ecc"].get<double>() == 0.9 && t["target"].get<double>() == 1e-12) {
+      found = true;
+      ASSERT_FALSE(t["nystrom"].is_null());
+      EXPECT_LE(t["nystrom"]["error"].get<double>(), 1e-12);
+    }
+  EXPECT_TRUE(found);
+}
+
+// The target table picks, per library, the fastest reference run whose error is at most the target,
+// and the ratio is odeint's time over nystrom's.
+TEST_F(BenchPeers, TargetsAreTheFastestRunsBelowTheTarget) {
+  ASSERT_EQ((*j_)["targets"].size(), 6u);
+  for (const auto& t : (*j_)["targets"]) {
+    const double e = t["ecc"].get<double>(), target = t["target"].get<double>();
+    for (const char* lib : {"nystrom", "odeint"}) {
+      double best = INFINITY;
+      for (const auto& r : (*j_)["runs"])
+        if (r["library"] == lib && r["ecc"].get<double>() == e && r["ok"].get<bool>() && r["reference"].get<bool>() &&
+            !r["error"].is_null() && r["error"].get<double>() <= target)
+          best = std::min(best, r["seconds"].get<double>());
+      if (t[lib].is_null()) {
+        EXPECT_EQ(best, INFINITY) << lib << " e=" << e << " target " << target;
+      } else {
+        EXPECT_EQ(t[lib]["seconds"].get<double>(), best);
+        EXPECT_LE(t[lib]["error"].get<double>(), target);
+      }
+    }
+    if (!t["nystrom"].is_null() && !t["odeint"].is_null()) {
+      EXPECT_DOUBLE_EQ(t["ratio"].get<double>(), t["odeint"]["seconds"].get<double>() / t["nystrom"]["seconds"].get<double>());
+    } else {
+      EXPECT_TRUE(t["ratio"].is_null());
+    }
+  }
+}
+
+// Compensated summation (the default for double) lowers the round-off floor (smallest error of the
+// sweep) at e = 0.5, where the quick sweeps reach it.
+TEST_F(BenchPeers, CompensationLowersTheRoundOffFloor) {
+  for (const auto& c : (*j_)["compensation"])
+    if (c["ecc"].get<double>() == 0.5) {
+      ASSERT_FALSE(c["min_error_on"].is_null());
+      ASSERT_FALSE(c["min_error_off"].is_null());
+      EXPECT_LT(3 * c["min_error_on"].get<double>(), c["min_error_off"].get<double>()) << c["method"];
+    }
+}
+
+TEST(BenchPeersCli, BadInputIsAUsageError) {
+  const auto dir = fs::temp_directory_path() / ("nystrom-peers-bad-" + std::to_string(::getpid()));
+  for (const char* args : {"--periods 0", "--ecc 1.5", "--ecc x"}) {
+    const int code = shell(tool() + " bench-peers --quick --no-plot --out " + dir.string() + " " + args +
+                           " >/dev/null 2>&1 </dev/null");
+    EXPECT_EQ(code, 2) << args;
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
