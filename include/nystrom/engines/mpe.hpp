@@ -258,43 +258,15 @@ class MpeStepper {
     }
     const std::size_t m = base_.scheme().steps.size();
     auto product = [&](std::size_t i, State<V>& out) NYSTROM_ALWAYS_INLINE {
-      resize_like(out.q, s.q);
-      resize_like(out.v, s.v);
-      assign(out.q, s.q);
-      assign(out.v, s.v);
+      start_product<Comp>(s, a0, out, a, pcq, pcv);
       bool valid = starts_with_kick_;
-      if (valid) assign(a, a0);
-      if constexpr (Comp) {
-        resize_like(pcq, s.q);
-        resize_like(pcv, s.q);
-        for (auto& e : pcq) e = scalar_type(0);
-        for (auto& e : pcv) e = scalar_type(0);
-      }
       base_.template advance_scaled<Comp>(out, a, valid, scaled_.data() + i * m, k_[i], pcq, pcv);
-      if constexpr (Comp) {
-        for (std::size_t j = 0; j < s.q.size(); ++j) {
-          out.q[j] = (out.q[j] - s.q[j]) + pcq[j];
-          out.v[j] = (out.v[j] - s.v[j]) + pcv[j];
-        }
-      }
+      if constexpr (Comp) to_increment(s, out, pcq, pcv);
     };
     if (lockstep_) {
       // All products in lockstep (SplittingStepper::advance_lockstep): bitwise the same end states.
       const std::size_t P = k_.size();
-      for (std::size_t r = 0; r < P; ++r) {
-        resize_like(products_[r].q, s.q);
-        resize_like(products_[r].v, s.v);
-        assign(products_[r].q, s.q);
-        assign(products_[r].v, s.v);
-        resize_like(pa_[r], s.q);
-        if (starts_with_kick_) assign(pa_[r], a0);
-        if constexpr (Comp) {
-          resize_like(pcq_[r], s.q);
-          resize_like(pcv_[r], s.q);
-          for (auto& e : pcq_[r]) e = scalar_type(0);
-          for (auto& e : pcv_[r]) e = scalar_type(0);
-        }
-      }
+      for (std::size_t r = 0; r < P; ++r) start_product<Comp>(s, a0, products_[r], pa_[r], pcq_[r], pcv_[r]);
       base_.template advance_lockstep<Comp>(P, products_.data(), pa_.data(), starts_with_kick_, scaled_.data(),
                                             k_.data(), pcq_.data(), pcv_.data());
       if constexpr (Comp) to_increments(P, s, products_, pcq_, pcv_);
@@ -372,15 +344,34 @@ class MpeStepper {
     combine<Comp>(P, s, comp, x);
   }
 
-  // Compensated products: T_r - s to full precision from the end state and its carries.
+  // A product's start: the state s, the force a0 at s.q when the base starts with a kick, zero carries.
+  template <bool Comp>
+  NYSTROM_ALWAYS_INLINE void start_product(const State<V>& s, const V& a0, State<V>& out, V& a, V& cq, V& cv) const {
+    resize_like(out.q, s.q);
+    resize_like(out.v, s.v);
+    assign(out.q, s.q);
+    assign(out.v, s.v);
+    resize_like(a, s.q);
+    if (starts_with_kick_) assign(a, a0);
+    if constexpr (Comp) {
+      resize_like(cq, s.q);
+      resize_like(cv, s.q);
+      for (auto& e : cq) e = scalar_type(0);
+      for (auto& e : cv) e = scalar_type(0);
+    }
+  }
+
+  // A compensated product: T - s to full precision from the end state T and its carries.
+  NYSTROM_ALWAYS_INLINE static void to_increment(const State<V>& s, State<V>& T, const V& cq, const V& cv) {
+    for (std::size_t j = 0; j < s.q.size(); ++j) {
+      T.q[j] = (T.q[j] - s.q[j]) + cq[j];
+      T.v[j] = (T.v[j] - s.v[j]) + cv[j];
+    }
+  }
+
   template <class Count, class TS, class CS>
   NYSTROM_ALWAYS_INLINE static void to_increments(Count P, const State<V>& s, TS& T, const CS& cq, const CS& cv) {
-    SplittingStepper<V, Force>::for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
-      for (std::size_t j = 0; j < s.q.size(); ++j) {
-        T[r].q[j] = (T[r].q[j] - s.q[j]) + cq[r][j];
-        T[r].v[j] = (T[r].v[j] - s.v[j]) + cv[r][j];
-      }
-    });
+    SplittingStepper<V, Force>::for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE { to_increment(s, T[r], cq[r], cv[r]); });
   }
 
   // s <- T_ref + sum_{i != ref} c_i (T_i - T_ref) (T: end states), or with Comp s += the same
@@ -450,27 +441,11 @@ class MpeStepper {
     for (long idx = 0; idx < P; ++idx) {
       const std::size_t r = order_[static_cast<std::size_t>(idx)];
       try {
-        State<V>& out = products_[r];
-        resize_like(out.q, s.q);
-        resize_like(out.v, s.v);
-        assign(out.q, s.q);
-        assign(out.v, s.v);
-        resize_like(pa_[r], s.q);
+        start_product<Comp>(s, a0, products_[r], pa_[r], pcq_[r], pcv_[r]);
         bool valid = starts_with_kick_;
-        if (valid) assign(pa_[r], a0);
-        if constexpr (Comp) {
-          resize_like(pcq_[r], s.q);
-          resize_like(pcv_[r], s.q);
-          for (auto& e : pcq_[r]) e = scalar_type(0);
-          for (auto& e : pcv_[r]) e = scalar_type(0);
-        }
-        workers_[r].template advance_scaled<Comp>(out, pa_[r], valid, scaled_.data() + r * m, k_[r], pcq_[r], pcv_[r]);
-        if constexpr (Comp) {
-          for (std::size_t j = 0; j < s.q.size(); ++j) {
-            out.q[j] = (out.q[j] - s.q[j]) + pcq_[r][j];
-            out.v[j] = (out.v[j] - s.v[j]) + pcv_[r][j];
-          }
-        }
+        workers_[r].template advance_scaled<Comp>(products_[r], pa_[r], valid, scaled_.data() + r * m, k_[r], pcq_[r],
+                                                  pcv_[r]);
+        if constexpr (Comp) to_increment(s, products_[r], pcq_[r], pcv_[r]);
       } catch (...) {
 #ifdef _OPENMP
 #pragma omp critical(nystrom_mpe_error)
@@ -506,10 +481,7 @@ class MpeStepper {
       for (auto& e : pc_.cq) e = scalar_type(0);
       for (auto& e : pc_.cv) e = scalar_type(0);
       base_.integrate_compensated(out, h / static_cast<real_type>(k_[i]), k_[i], pc_);
-      for (std::size_t j = 0; j < s.q.size(); ++j) {
-        out.q[j] = (out.q[j] - s.q[j]) + pc_.cq[j];
-        out.v[j] = (out.v[j] - s.v[j]) + pc_.cv[j];
-      }
+      to_increment(s, out, pc_.cq, pc_.cv);
     } else {
       base_.integrate(out, h / static_cast<real_type>(k_[i]), k_[i]);
     }
