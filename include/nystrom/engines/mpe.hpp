@@ -24,6 +24,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -303,10 +304,18 @@ class MpeStepper {
     }
   }
 
+  // The unrolled fixed-K loops pay off where a force is a short chain of hardware float operations
+  // whose latency the processor can overlap across products: std::array states of float or double.
+  // Other scalars (long double, complex, float128, dd, qd, MPFR) run the same lockstep order through
+  // advance_lockstep with a run-time product count, bitwise the same (tests/test_mpe_schedule.cpp),
+  // without 16 more instantiations of the engine per state type and force (compile time).
+  static constexpr bool fixed_lockstep =
+      is_std_array<V>::value && (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>);
+
   // Calls fixed_steps<Comp, K> for K = the number of products; false if there are more than 8.
   template <bool Comp>
   bool dispatch_fixed(State<V>& s, Compensator<V>& comp, long n) {
-    if constexpr (is_std_array<V>::value) {
+    if constexpr (fixed_lockstep) {
       switch (k_.size()) {
         case 1: fixed_steps<Comp, 1>(s, comp, n); return true;
         case 2: fixed_steps<Comp, 2>(s, comp, n); return true;
