@@ -1,0 +1,93 @@
+// The part of a run that depends on the scalar type, instantiated once per precision in its own
+// translation unit (runner_<precision>.cpp), so that the precisions compile in parallel.
+#pragma once
+
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <string>
+
+#include "cli.hpp"
+#include "nystrom/core/precision.hpp"
+#include "nystrom/engines/integrator.hpp"
+#include "nystrom/experiments/kepler.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/kepler.hpp"
+#include "runner.hpp"
+
+namespace nystrom::cli {
+
+namespace detail {
+
+template <class T>
+RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
+  HarmonicProblem<T> prob;
+  const long n = req.steps_per_period * req.periods;
+  const T h = HarmonicProblem<T>::period() / T(req.steps_per_period);
+  auto s = prob.initial_state();
+  long evals = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  EngineOptions opt{req.keep_complex};
+  if (def.info.complex) {
+    using C = std::complex<T>;
+    auto integ = make_integrator<std::array<C, 1>>(def, HarmonicForce{}, opt);
+    auto sc = convert_state<std::array<C, 1>>(s);
+    integ.integrate(sc, h, n);
+    s = convert_state<std::array<T, 1>>(sc);
+    evals = integ.force_evals();
+  } else {
+    auto integ = make_integrator<std::array<T, 1>>(def, HarmonicForce{}, opt);
+    integ.integrate(s, h, n);
+    evals = integ.force_evals();
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  RunReport r;
+  r.steps = n;
+  r.force_evals = evals;
+  r.h = as_double(h);
+  r.seconds = std::chrono::duration<double>(t1 - t0).count();
+  using std::abs;
+  const auto ex = prob.exact(h * T(n));
+  r.position_error = as_double(abs(s.q[0] - ex.q[0]));
+  const T e = (s.q[0] * s.q[0] + s.v[0] * s.v[0]) / T(2);
+  r.energy_error = as_double(abs(e - T(1) / T(2)) / (T(1) / T(2)));
+  return r;
+}
+
+}  // namespace detail
+
+/// Kepler or harmonic run of `def` in scalar type T (validated request; GBS when `gbs`).
+template <class T>
+RunReport run_in_precision(const RunRequest& req, const MethodDef& def, bool gbs) {
+  using detail::run_harmonic;
+  if (req.problem == "kepler") {
+    if (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1)
+      throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
+    const auto k = gbs ? run_kepler_gbs<T>(req.ecc, req.tol, req.periods)
+                   : def.info.adaptive
+                       ? run_kepler_adaptive<T>(def, req.ecc, req.tol, req.periods)
+                       : run_kepler<T>(def, req.ecc, req.steps_per_period, req.periods, EngineOptions{req.keep_complex});
+    RunReport out;
+    out.ecc = req.ecc;
+    out.steps = k.steps;
+    out.force_evals = k.force_evals;
+    out.h = k.h;
+    out.precession_per_period = k.precession_per_period;
+    out.energy_error = k.energy_error;
+    out.position_error = k.position_error;
+    out.seconds = k.seconds;
+    return out;
+  }
+  if (req.problem == "harmonic") {
+    if (def.info.adaptive) throw UsageError("adaptive methods run on the kepler problem only");
+    return run_harmonic<T>(req, def);
+  }
+  std::string known;
+  for (const auto& p : problem_names()) known += (known.empty() ? "" : ", ") + p;
+  throw UsageError("unknown problem '" + req.problem + "' (known: " + known + ")");
+}
+
+#define NYSTROM_RUNNER_INSTANTIATE(T) \
+  template RunReport run_in_precision<T>(const RunRequest&, const MethodDef&, bool);
+
+}  // namespace nystrom::cli
