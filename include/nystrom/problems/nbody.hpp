@@ -357,40 +357,64 @@ NYSTROM_TARGET_AVX512 inline void avx512_diag_complex(const ComplexTileData& d, 
   }
 }
 
+/// Both directions of the complex interactions between block I (at i0) and block J (at j0), each pair
+/// once. Two rows i, i+1 at a time, as in avx512_pair_real: the loads of block J and the read-modify-write
+/// of its accelerations serve two rows, and the two rows are independent dependency chains.
 template <bool Masked>
 NYSTROM_TARGET_AVX512 inline void avx512_pair_complex(const ComplexTileData& d, std::size_t i0, std::size_t j0,
                                                       std::size_t B, double eps2) {
   const __m512d e2 = _mm512_set1_pd(eps2);
-  double* __restrict const out[6] = {d.axr, d.axi, d.ayr, d.ayi, d.azr, d.azi};
-  for (std::size_t i = i0; i < i0 + B; ++i) {
-    const __m512d qxr = _mm512_set1_pd(d.xr[i]), qxi = _mm512_set1_pd(d.xi[i]), qyr = _mm512_set1_pd(d.yr[i]),
-                  qyi = _mm512_set1_pd(d.yi[i]), qzr = _mm512_set1_pd(d.zr[i]), qzi = _mm512_set1_pd(d.zi[i]);
-    const __m512d mi = _mm512_set1_pd(d.m[i]);
-    __m512d s[6];
-    for (auto& x : s) x = _mm512_setzero_pd();
+  double* __restrict const axr = d.axr;
+  double* __restrict const axi = d.axi;
+  double* __restrict const ayr = d.ayr;
+  double* __restrict const ayi = d.ayi;
+  double* __restrict const azr = d.azr;
+  double* __restrict const azi = d.azi;
+  double* const out[6] = {axr, axi, ayr, ayi, azr, azi};
+  for (std::size_t i = i0; i < i0 + B; i += 2) {
+    const std::size_t k = i + 1;
+    __m512d s[6], t[6];
+    for (int c = 0; c < 6; ++c) s[c] = t[c] = _mm512_setzero_pd();
     for (std::size_t j = j0; j < j0 + B; j += 8) {
-      __m512d dd[6], wr, wi;
-      const __mmask8 nz = avx512_complex_w(d, j, qxr, qxi, qyr, qyi, qzr, qzi, e2, dd, wr, wi);
+      __m512d dd[6], ee[6], wr, wi, vr, vi;
+      const __mmask8 nz = avx512_complex_w(d, j, _mm512_set1_pd(d.xr[i]), _mm512_set1_pd(d.xi[i]),
+                                           _mm512_set1_pd(d.yr[i]), _mm512_set1_pd(d.yi[i]), _mm512_set1_pd(d.zr[i]),
+                                           _mm512_set1_pd(d.zi[i]), e2, dd, wr, wi);
+      const __mmask8 mz = avx512_complex_w(d, j, _mm512_set1_pd(d.xr[k]), _mm512_set1_pd(d.xi[k]),
+                                           _mm512_set1_pd(d.yr[k]), _mm512_set1_pd(d.yi[k]), _mm512_set1_pd(d.zr[k]),
+                                           _mm512_set1_pd(d.zi[k]), e2, ee, vr, vi);
       if constexpr (Masked) {
         wr = _mm512_maskz_mov_pd(nz, wr);
         wi = _mm512_maskz_mov_pd(nz, wi);
+        vr = _mm512_maskz_mov_pd(mz, vr);
+        vi = _mm512_maskz_mov_pd(mz, vi);
       } else {
-        (void)nz;
+        (void)nz, (void)mz;
       }
-      const __m512d mj = _mm512_loadu_pd(d.m + j);
+      const __m512d mj = _mm512_loadu_pd(d.m + j), mi = _mm512_set1_pd(d.m[i]), mk = _mm512_set1_pd(d.m[k]);
       const __m512d wjr = _mm512_mul_pd(wr, mj), wji = _mm512_mul_pd(wi, mj);
       const __m512d wir = _mm512_mul_pd(wr, mi), wii = _mm512_mul_pd(wi, mi);
+      const __m512d vjr = _mm512_mul_pd(vr, mj), vji = _mm512_mul_pd(vi, mj);
+      const __m512d vkr = _mm512_mul_pd(vr, mk), vki = _mm512_mul_pd(vi, mk);
       for (int c = 0; c < 3; ++c) {
-        const __m512d dr = dd[2 * c], di = dd[2 * c + 1];
+        const __m512d dr = dd[2 * c], di = dd[2 * c + 1], er = ee[2 * c], ei = ee[2 * c + 1];
         s[2 * c] = _mm512_fnmadd_pd(wji, di, _mm512_fmadd_pd(wjr, dr, s[2 * c]));
         s[2 * c + 1] = _mm512_fmadd_pd(wji, dr, _mm512_fmadd_pd(wjr, di, s[2 * c + 1]));
+        t[2 * c] = _mm512_fnmadd_pd(vji, ei, _mm512_fmadd_pd(vjr, er, t[2 * c]));
+        t[2 * c + 1] = _mm512_fmadd_pd(vji, er, _mm512_fmadd_pd(vjr, ei, t[2 * c + 1]));
+        // a_j -= m_i w_ij d_ij, then row i+1: the same order as one row at a time.
         double* pr = out[2 * c] + j;
         double* pi = out[2 * c + 1] + j;
-        _mm512_storeu_pd(pr, _mm512_fmadd_pd(wii, di, _mm512_fnmadd_pd(wir, dr, _mm512_loadu_pd(pr))));
-        _mm512_storeu_pd(pi, _mm512_fnmadd_pd(wii, dr, _mm512_fnmadd_pd(wir, di, _mm512_loadu_pd(pi))));
+        const __m512d ar = _mm512_fmadd_pd(wii, di, _mm512_fnmadd_pd(wir, dr, _mm512_loadu_pd(pr)));
+        const __m512d ai = _mm512_fnmadd_pd(wii, dr, _mm512_fnmadd_pd(wir, di, _mm512_loadu_pd(pi)));
+        _mm512_storeu_pd(pr, _mm512_fmadd_pd(vki, ei, _mm512_fnmadd_pd(vkr, er, ar)));
+        _mm512_storeu_pd(pi, _mm512_fnmadd_pd(vki, er, _mm512_fnmadd_pd(vkr, ei, ai)));
       }
     }
-    for (int c = 0; c < 6; ++c) out[c][i] += avx512_sum(s[c]);
+    for (int c = 0; c < 6; ++c) {
+      out[c][i] += avx512_sum(s[c]);
+      out[c][k] += avx512_sum(t[c]);
+    }
   }
 }
 
