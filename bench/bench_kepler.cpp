@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
@@ -248,19 +249,10 @@ bool check_hand_loops() {
   return ok;
 }
 
-/// Console output as usual, plus the minimum CPU time per step of every benchmark for the summary.
-class SummaryReporter : public benchmark::ConsoleReporter {
+/// The summary: minimum CPU time per step of every benchmark (bench_common.hpp), ratios to the hand loops.
+class SummaryReporter : public bench::MinTimeReporter {
  public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const auto& r : runs) {
-      if (r.run_type != Run::RT_Iteration || r.error_occurred || r.iterations == 0) continue;
-      const double ns_per_step = r.cpu_accumulated_time * 1e9 / (static_cast<double>(r.iterations) * kSteps);
-      const std::string name = r.run_name.function_name;
-      auto it = best_.find(name);
-      if (it == best_.end() || ns_per_step < it->second) best_[name] = ns_per_step;
-    }
-  }
+  SummaryReporter() : MinTimeReporter(Clock::cpu, static_cast<double>(kSteps), 1e9) {}
   void summary() const {
     std::printf("\nKepler e = %.1f, double, %ld steps per batch; minimum over repetitions of CPU time per step\n", kEcc,
                 kSteps);
@@ -269,31 +261,28 @@ class SummaryReporter : public benchmark::ConsoleReporter {
     if (plain) std::printf(" %12s %9s", "plain ns", "plain/hand");
     std::printf("\n");
     for (const auto& c : cases()) {
-      const auto hand = best_.find(std::string("hand/") + c.name), lib = best_.find(std::string("library/") + c.name);
-      if (lib == best_.end() || hand == best_.end()) continue;
-      const double ratio = lib->second / hand->second;
-      std::printf("%-8s %10.2f %12.2f %9.3f", c.name, hand->second, lib->second, ratio);
-      const auto pl = best_.find(std::string("library-plain/") + c.name);
-      if (plain && pl != best_.end()) std::printf(" %12.2f %9.3f", pl->second, pl->second / hand->second);
-      const auto sq = best_.find(std::string("library-plain-sequential/") + c.name);
-      if (sq != best_.end()) std::printf("   sequential products: %8.2f ns, %6.3f x hand", sq->second, sq->second / hand->second);
+      const double* hand = best(std::string("hand/") + c.name);
+      const double* lib = best(std::string("library/") + c.name);
+      if (!lib || !hand) continue;
+      std::printf("%-8s %10.2f %12.2f %9.3f", c.name, *hand, *lib, *lib / *hand);
+      const double* pl = best(std::string("library-plain/") + c.name);
+      if (plain && pl) std::printf(" %12.2f %9.3f", *pl, *pl / *hand);
+      const double* sq = best(std::string("library-plain-sequential/") + c.name);
+      if (sq) std::printf("   sequential products: %8.2f ns, %6.3f x hand", *sq, *sq / *hand);
       std::printf("\n");
     }
     std::printf("(target: library / hand-written <= 1.10%s)\n",
                 plain ? "; 'plain' = the library with compensated summation off, as the hand-written loops" : "");
     // Issue 8: an M8 step (10 forces, products in lockstep) against 10 sequential force evaluations, i.e.
     // 10 steps of the hand-written velocity Verlet loop (one force per step, each depending on the last).
-    const auto vv = best_.find("hand/VV"), m8 = best_.find("library-plain/M8"), m8s = best_.find("library-plain-sequential/M8");
-    if (vv != best_.end() && m8 != best_.end()) {
+    const double *vv = best("hand/VV"), *m8 = best("library-plain/M8"), *m8s = best("library-plain-sequential/M8");
+    if (vv && m8) {
       std::printf("M8 step (lockstep products, plain) / 10 sequential forces (10 hand VV steps): %.3f (target <= 0.5)\n",
-                  m8->second / (10 * vv->second));
-      if (m8s != best_.end())
-        std::printf("M8 step (sequential products, plain) / 10 sequential forces: %.3f\n", m8s->second / (10 * vv->second));
+                  *m8 / (10 * *vv));
+      if (m8s) std::printf("M8 step (sequential products, plain) / 10 sequential forces: %.3f\n", *m8s / (10 * *vv));
     }
   }
 
- private:
-  std::map<std::string, double> best_;
 };
 
 }  // namespace
@@ -314,14 +303,7 @@ int main(int argc, char** argv) {
                                    [&c](benchmark::State& s) { bm_library(s, c, true, true); })
           ->MinTime(0.2);
   }
-  // Five repetitions unless the command line says otherwise.
-  std::vector<char*> args(argv, argv + argc);
-  std::string reps = "--benchmark_repetitions=5";
-  if (std::none_of(args.begin() + 1, args.end(), [](const char* a) { return std::string(a).rfind("--benchmark_repetitions", 0) == 0; }))
-    args.push_back(reps.data());
-  int n = static_cast<int>(args.size());
-  benchmark::Initialize(&n, args.data());
-  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
+  if (!bench::initialize({argv, argv + argc}, 5)) return 1;  // five repetitions unless told otherwise
   if (!check_hand_loops()) return 1;
   SummaryReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);

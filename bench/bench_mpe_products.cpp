@@ -24,6 +24,7 @@
 #include <omp.h>
 #endif
 
+#include "bench_common.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/nbody.hpp"
@@ -73,8 +74,6 @@ auto make(Mode mode) {
   return make_integrator<std::vector<double>>(resolve_method("M8"), force, opt);
 }
 
-std::map<std::string, double> g_best;  // minimum wall seconds per step
-
 void bm_step(benchmark::State& state, Mode mode) {
   auto integ = make(mode);
   const State<std::vector<double>> s0 = particles().s;
@@ -85,19 +84,6 @@ void bm_step(benchmark::State& state, Mode mode) {
   }
 }
 
-class Reporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const auto& r : runs) {
-      if (r.run_type != Run::RT_Iteration || r.error_occurred || r.iterations == 0) continue;
-      const double sec = r.real_accumulated_time / static_cast<double>(r.iterations);
-      const std::string name = r.run_name.function_name;
-      auto it = g_best.find(name);
-      if (it == g_best.end() || sec < it->second) g_best[name] = sec;
-    }
-  }
-};
 
 bool check_identical() {
   std::vector<State<std::vector<double>>> out;
@@ -122,13 +108,7 @@ int main(int argc, char** argv) {
     else
       args.push_back(argv[i]);
   }
-  std::string reps = "--benchmark_repetitions=3";
-  if (std::none_of(args.begin() + 1, args.end(),
-                   [](const char* a) { return std::string(a).rfind("--benchmark_repetitions", 0) == 0; }))
-    args.push_back(reps.data());
-  int n = static_cast<int>(args.size());
-  benchmark::Initialize(&n, args.data());
-  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
+  if (!bench::initialize(args, 3)) return 1;  // three repetitions unless told otherwise
   std::printf("M8 on a Plummer sphere, N = %zu, %d threads\n", g_n, all_threads());
   if (!check_identical()) return 1;
   for (Mode m : {Mode::seq1, Mode::seqP, Mode::concP})
@@ -136,9 +116,12 @@ int main(int argc, char** argv) {
         ->UseRealTime()
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.5);
-  Reporter reporter;
+  bench::MinTimeReporter reporter(bench::MinTimeReporter::Clock::real, 1, 1);  // seconds per step
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  const double s1 = g_best["sequential-1t"], sp = g_best["sequential-Pt"], cp = g_best["concurrent-Pt"];
+  const double* t1 = reporter.best("sequential-1t");
+  const double* tp = reporter.best("sequential-Pt");
+  const double* tc = reporter.best("concurrent-Pt");
+  const double s1 = t1 ? *t1 : 0, sp = tp ? *tp : 0, cp = tc ? *tc : 0;
   if (s1 > 0 && sp > 0 && cp > 0) {
     std::printf("\nM8 step, N = %zu, wall time (minimum over repetitions):\n", g_n);
     std::printf("  sequential products, force on 1 thread:       %9.2f ms\n", s1 * 1e3);

@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "nystrom/core/precision.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
@@ -95,19 +96,10 @@ bool check_agreement() {
   return ok;
 }
 
-/// Console output as usual, plus the minimum CPU time per step of every benchmark for the summary.
-class SummaryReporter : public benchmark::ConsoleReporter {
+/// The summary: minimum CPU time per step of every benchmark (bench_common.hpp), ratios to double.
+class SummaryReporter : public bench::MinTimeReporter {
  public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const auto& r : runs) {
-      if (r.run_type != Run::RT_Iteration || r.error_occurred || r.iterations == 0) continue;
-      const double ns_per_step = r.cpu_accumulated_time * 1e9 / (static_cast<double>(r.iterations) * kSteps);
-      const std::string name = r.run_name.function_name;
-      auto it = best_.find(name);
-      if (it == best_.end() || ns_per_step < it->second) best_[name] = ns_per_step;
-    }
-  }
+  SummaryReporter() : MinTimeReporter(Clock::cpu, static_cast<double>(kSteps), 1e9) {}
   void summary() const {
     std::printf("\n%s on Kepler e = %.1f, %ld steps per batch; minimum over repetitions of CPU time per step\n", kMethod,
                 kEcc, kSteps);
@@ -116,23 +108,20 @@ class SummaryReporter : public benchmark::ConsoleReporter {
 #else
     std::printf("built without FMA: double-double products by Dekker's splitting (see NYSTROM_NATIVE)\n");
 #endif
-    const auto base = best_.find("M8/double");
+    const double* base = best("M8/double");
     std::printf("%-12s %12s %10s\n", "precision", "ns/step", "/ double");
     for (const auto& p : precisions()) {
-      const auto it = best_.find("M8/" + p);
-      if (it == best_.end()) continue;
-      if (base == best_.end()) {
-        std::printf("%-12s %12.1f %10s\n", p.c_str(), it->second, "-");
+      const double* t = best("M8/" + p);
+      if (!t) continue;
+      if (!base) {
+        std::printf("%-12s %12.1f %10s\n", p.c_str(), *t, "-");
       } else {
-        const double ratio = it->second / base->second;
-        std::printf("%-12s %12.1f %10.2f%s\n", p.c_str(), it->second, ratio,
-                    p == "dd" && ratio > 10 ? "  (target for dd: <= 10)" : "");
+        const double ratio = *t / *base;
+        std::printf("%-12s %12.1f %10.2f%s\n", p.c_str(), *t, ratio, p == "dd" && ratio > 10 ? "  (target for dd: <= 10)" : "");
       }
     }
   }
 
- private:
-  std::map<std::string, double> best_;
 };
 
 }  // namespace
@@ -140,15 +129,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
 int main(int argc, char** argv) {
   for (const auto& p : precisions())
     benchmark::RegisterBenchmark(("M8/" + p).c_str(), [p](benchmark::State& s) { bm_precision(s, p); })->MinTime(0.2);
-  // Five repetitions unless the command line says otherwise.
-  std::vector<char*> args(argv, argv + argc);
-  std::string reps = "--benchmark_repetitions=5";
-  if (std::none_of(args.begin() + 1, args.end(),
-                   [](const char* a) { return std::string(a).rfind("--benchmark_repetitions", 0) == 0; }))
-    args.push_back(reps.data());
-  int n = static_cast<int>(args.size());
-  benchmark::Initialize(&n, args.data());
-  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
+  if (!bench::initialize({argv, argv + argc}, 5)) return 1;  // five repetitions unless told otherwise
   if (!check_agreement()) return 1;
   SummaryReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
