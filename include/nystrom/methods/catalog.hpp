@@ -5,6 +5,8 @@
 //   M<2n>                 natural-sequence MPE of any even order on position Verlet (M4 ... M16 listed)
 //   mpe:1,2,4             MPE on position Verlet with the given sequence
 //   mpe-vv:1,2,3          MPE on velocity Verlet
+//   M<2n>-adaptive        natural-sequence MPE with adaptive steps (engines/adaptive_mpe.hpp; needs a tolerance)
+//   mpe-adaptive:1,2,3    adaptive MPE on position Verlet (also mpe-pv-adaptive:), mpe-vv-adaptive: on velocity Verlet
 //   adjoint:NAME          the adjoint of a splitting method (sub-steps reversed)
 //   file:PATH             a splitting method from a method file (format: nystrom/analysis/method_file.hpp)
 //   triplejump:P          Yoshida's triple jump of even order P on position Verlet (also triplejump-pv:P);
@@ -113,6 +115,27 @@ inline MethodDef resolve_method(const std::string& spec) {
     detail::finalize_info(d);
     return d;
   };
+  // Adaptive multi-product methods (engines/adaptive_mpe.hpp): M<2n>-adaptive, mpe-adaptive:K, mpe-vv-adaptive:K.
+  auto adaptive_mpe = [&finalize](const std::vector<long>& k, const std::string& base, const std::string& name) {
+    if (k.size() < 2)
+      throw std::invalid_argument("an adaptive MPE needs at least two products (the error estimate drops one): '" + name + "'");
+    MethodDef d = methods::mpe_method(k, base, name);
+    d.info.adaptive = true;
+    d.info.description += ", adaptive step (embedded estimate: the products without the largest k)";
+    return finalize(d);
+  };
+  if (ls.rfind("mpe-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(13)), "PV", spec);
+  if (ls.rfind("mpe-pv-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(16)), "PV", spec);
+  if (ls.rfind("mpe-vv-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(16)), "VV", spec);
+  if (ls.size() > 10 && ls[0] == 'm' && ls.substr(ls.size() - 9) == "-adaptive" &&
+      std::all_of(ls.begin() + 1, ls.end() - 9, ::isdigit)) {
+    const long order = std::stol(ls.substr(1, ls.size() - 10));
+    if (order < 4 || order % 2 != 0 || order > 400)
+      throw std::invalid_argument("adaptive MPE order must be an even number between 4 and 400, got '" + spec + "'");
+    std::vector<long> k;
+    for (long i = 1; i <= order / 2; ++i) k.push_back(i);
+    return adaptive_mpe(k, "PV", "M" + std::to_string(order) + "-adaptive");
+  }
   if (ls.rfind("mpe:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(4)), "PV", spec));
   if (ls.rfind("mpe-pv:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(7)), "PV", spec));
   if (ls.rfind("mpe-vv:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(7)), "VV", spec));

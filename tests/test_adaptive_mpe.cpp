@@ -1,0 +1,242 @@
+// The adaptive multi-product expansion (engines/adaptive_mpe.hpp): the embedded estimate has the
+// order it claims, the error on Kepler follows the tolerance, the step shrinks at pericentre and steps
+// are rejected there at e = 0.9, force evaluations are counted exactly, the lockstep and sequential
+// schedules give bitwise the same results, and bad input fails with std::invalid_argument.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "nystrom/engines/adaptive_mpe.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/kepler.hpp"
+
+using namespace nystrom;
+
+namespace {
+
+using V2 = std::array<double, 2>;
+using VD = std::vector<double>;
+
+struct CountingKepler {
+  long* calls;
+  template <class V>
+  void operator()(const V& q, V& a) const {
+    ++*calls;
+    const double r2 = q[0] * q[0] + q[1] * q[1];
+    const double f = -1.0 / (r2 * std::sqrt(r2));
+    a[0] = f * q[0];
+    a[1] = f * q[1];
+  }
+};
+
+AdaptiveOptions with_tol(double tol) {
+  AdaptiveOptions o;
+  o.tol = tol;
+  return o;
+}
+
+double position_error(const State<V2>& s, double ecc, double t) {
+  const KeplerProblem<long double> kp(static_cast<long double>(ecc));
+  const auto ex = kp.exact(static_cast<long double>(t));
+  return static_cast<double>(std::hypot(static_cast<long double>(s.q[0]) - ex.q[0], static_cast<long double>(s.q[1]) - ex.q[1]));
+}
+
+}  // namespace
+
+// The exact coefficients: both combinations sum to 1, the error weights to 0, and the dropped product
+// is the one of largest k.
+TEST(AdaptiveMpe, CoefficientsOfThePair) {
+  const auto ac = adaptive_mpe_coefficients({1, 2, 3, 4, 5});
+  EXPECT_EQ(ac.dropped, 4u);
+  mpq_class sh(0), sl(0), sd(0);
+  for (const auto& c : ac.high.c) sh += c;
+  for (const auto& c : ac.low.c) sl += c;
+  for (const auto& c : ac.diff) sd += c;
+  EXPECT_EQ(sh, 1);
+  EXPECT_EQ(sl, 1);
+  EXPECT_EQ(sd, 0);
+  EXPECT_EQ(ac.low.order(), 8);
+  EXPECT_EQ(ac.diff[4], ac.high.c[4]);
+  EXPECT_EQ(adaptive_mpe_coefficients({3, 1, 2}).dropped, 0u);
+}
+
+// One trial step from the apocentre of e = 0.5: the estimate scales like h^(2n-1) and the propagated
+// solution's local error like h^(2n+1) (M8: 7 and 9), observed over h, h/2, h/4.
+TEST(AdaptiveMpe, EmbeddedEstimateHasItsOrder) {
+  long calls = 0;
+  auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("M8-adaptive"), CountingKepler{&calls}, with_tol(1e-8));
+  EXPECT_EQ(ai.error_order(), 6);
+  EXPECT_EQ(ai.method_order(), 8);
+  const KeplerProblem<double> kp(0.5);
+  const State<V2> s0 = kp.initial_state();
+  std::vector<double> est, loc;
+  for (double h : {0.4, 0.2, 0.1}) {
+    State<V2> inc, err;
+    ai.trial_step(s0, h, inc, err);
+    est.push_back(std::hypot(err.q[0], err.q[1]));
+    State<V2> s1 = s0;
+    for (int i = 0; i < 2; ++i) s1.q[i] += inc.q[i];
+    loc.push_back(position_error(s1, 0.5, h));
+  }
+  for (int i = 0; i + 1 < 3; ++i) {
+    const double pe = std::log2(est[i] / est[i + 1]);
+    EXPECT_NEAR(pe, 7.0, 0.6) << "estimate order between h = " << 0.4 / (1 << i) << " and half";
+  }
+  // The local error at h = 0.1 is near rounding: use the two larger steps.
+  EXPECT_NEAR(std::log2(loc[0] / loc[1]), 9.0, 0.8);
+  EXPECT_LT(loc[1], 0.1 * est[1]);  // local extrapolation: the propagated solution is the better one
+  EXPECT_EQ(calls, 3 * 10);         // sum k = 10 forces per trial (position Verlet base: no shared force)
+}
+
+// Kepler e = 0.5 over one period: the error follows the tolerance (bounded by a fixed multiple of it,
+// and smaller at the tighter tolerance) and the work grows slowly.
+TEST(AdaptiveMpe, KeplerErrorTracksTheTolerance) {
+  const double T = KeplerProblem<double>::period();
+  std::vector<double> errs;
+  std::vector<long> work;
+  for (double tol : {1e-8, 1e-11}) {
+    long calls = 0;
+    auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("M10-adaptive"), CountingKepler{&calls}, with_tol(tol));
+    State<V2> s = KeplerProblem<double>(0.5).initial_state();
+    const AdaptiveStats st = ai.integrate_to(s, 0.0, T);
+    EXPECT_EQ(st.force_evals, calls);
+    errs.push_back(position_error(s, 0.5, T));
+    work.push_back(st.force_evals);
+    EXPECT_LT(errs.back(), 100 * tol) << tol;
+  }
+  EXPECT_LT(errs[1], 1e-2 * errs[0]);
+  EXPECT_GT(work[1], work[0]);
+  EXPECT_LT(work[1], 4 * work[0]);  // about tol^(-1/9): 2.2x for 1000x
+}
+
+// Kepler e = 0.9: steps are rejected (the step grows on the way out and must shrink coming in), the
+// step at pericentre is far smaller than at apocentre, the end time is hit exactly, and the force
+// count is exact: sum k forces per attempted step plus the starting-step estimate.
+TEST(AdaptiveMpe, PericentreShrinksTheStepAndRejects) {
+  long calls = 0;
+  auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("M12-adaptive"), CountingKepler{&calls}, with_tol(1e-8));
+  State<V2> s = KeplerProblem<double>(0.9).initial_state();
+  const double T = KeplerProblem<double>::period();
+  double t_prev = 0, h_peri = INFINITY, h_apo = 0, t_last = -1;
+  const AdaptiveStats st = ai.integrate_to(s, 0.0, 2 * T, [&](double t, const State<V2>& x) {
+    const double r = std::hypot(x.q[0], x.q[1]);
+    const double h = t - t_prev;
+    if (t > 0 && t < 2 * T - 1e-9) {
+      if (r < 0.2) h_peri = std::min(h_peri, h);
+      if (r > 1.8) h_apo = std::max(h_apo, h);
+    }
+    t_prev = t;
+    t_last = t;
+  });
+  EXPECT_EQ(t_last, 2 * T);
+  EXPECT_GT(st.rejected, 0);
+  EXPECT_LT(st.rejected, st.accepted);
+  EXPECT_LT(h_peri, 0.05 * h_apo);
+  EXPECT_EQ(st.force_evals, calls);
+  EXPECT_EQ(st.force_evals, 21 * (st.accepted + st.rejected) + 2);
+  EXPECT_LT(position_error(s, 0.9, 2 * T), 1e-5);
+}
+
+// Many short calls continue the run (step size and compensation carry kept) and land on each end time.
+TEST(AdaptiveMpe, ContinuesAcrossCalls) {
+  long calls = 0;
+  auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("M10-adaptive"), CountingKepler{&calls}, with_tol(1e-10));
+  State<V2> s = KeplerProblem<double>(0.5).initial_state();
+  const double T = KeplerProblem<double>::period();
+  for (int i = 0; i < 10; ++i) ai.integrate_to(s, T * i / 10, T * (i + 1) / 10);
+  EXPECT_LT(position_error(s, 0.5, T), 1e-8);
+  EXPECT_EQ(ai.total().force_evals, calls);
+}
+
+// The schedules: lockstep (unrolled, std::array), sequential, and the run-time lockstep of std::vector
+// states give bitwise the same trajectory; with and without compensated summation.
+TEST(AdaptiveMpe, SchedulesAreBitwiseIdentical) {
+  for (Compensation comp : {Compensation::on, Compensation::off}) {
+    auto run_array = [&](MpeSchedule sched) {
+      long calls = 0;
+      EngineOptions eo;
+      eo.compensated = comp;
+      eo.mpe_schedule = sched;
+      auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("mpe-adaptive:1,2,3,5"), CountingKepler{&calls},
+                                                 with_tol(1e-9), eo);
+      EXPECT_EQ(ai.lockstep(), sched != MpeSchedule::sequential);
+      State<V2> s = KeplerProblem<double>(0.9).initial_state();
+      const AdaptiveStats st = ai.integrate_to(s, 0.0, 7.0);
+      return std::pair(s, st.force_evals);
+    };
+    const auto [a, fa] = run_array(MpeSchedule::lockstep);
+    const auto [b, fb] = run_array(MpeSchedule::sequential);
+    EXPECT_EQ(fa, fb);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_EQ(a.q[i], b.q[i]);
+      EXPECT_EQ(a.v[i], b.v[i]);
+    }
+    for (MpeSchedule sched : {MpeSchedule::lockstep, MpeSchedule::sequential}) {
+      long calls = 0;
+      EngineOptions eo;
+      eo.compensated = comp;
+      eo.mpe_schedule = sched;
+      auto ai = make_adaptive_mpe_integrator<VD>(resolve_method("mpe-adaptive:1,2,3,5"), CountingKepler{&calls},
+                                                 with_tol(1e-9), eo);
+      const auto s0 = KeplerProblem<double>(0.9).initial_state();
+      State<VD> s{{s0.q[0], s0.q[1]}, {s0.v[0], s0.v[1]}};
+      const AdaptiveStats st = ai.integrate_to(s, 0.0, 7.0);
+      EXPECT_EQ(st.force_evals, fa);
+      for (int i = 0; i < 2; ++i) {
+        EXPECT_EQ(s.q[i], a.q[i]);
+        EXPECT_EQ(s.v[i], a.v[i]);
+      }
+    }
+  }
+}
+
+// A base that starts with a kick (velocity Verlet) shares the force at q_0 among the products: one
+// more force per accepted step (kept across a rejected one).
+TEST(AdaptiveMpe, VelocityVerletBaseCountsTheSharedForce) {
+  long calls = 0;
+  auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("mpe-vv-adaptive:1,2,3,4"), CountingKepler{&calls},
+                                             with_tol(1e-9));
+  State<V2> s = KeplerProblem<double>(0.5).initial_state();
+  const double T = KeplerProblem<double>::period();
+  const AdaptiveStats st = ai.integrate_to(s, 0.0, T);
+  EXPECT_EQ(st.force_evals, calls);
+  EXPECT_EQ(st.force_evals, 10 * (st.accepted + st.rejected) + st.accepted + 2);
+  EXPECT_LT(position_error(s, 0.5, T), 1e-7);
+}
+
+TEST(AdaptiveMpe, BadInputThrows) {
+  long calls = 0;
+  const MethodDef def = resolve_method("M10-adaptive");
+  EXPECT_TRUE(def.info.adaptive);
+  EXPECT_EQ(def.info.order, 10);
+  EXPECT_EQ(def.info.forces_per_step, 15);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (double tol : {0.0, -1e-8, nan, double(INFINITY), 1e-17})
+    EXPECT_THROW(make_adaptive_mpe_integrator<V2>(def, CountingKepler{&calls}, with_tol(tol)), std::invalid_argument)
+        << tol;
+  for (const char* spec : {"mpe-adaptive:", "mpe-adaptive:1", "mpe-adaptive:1,1,2", "mpe-adaptive:0,1", "M2-adaptive",
+                           "M7-adaptive", "mpe-vv-adaptive:x"})
+    EXPECT_THROW(resolve_method(spec), std::invalid_argument) << spec;
+  EXPECT_THROW(adaptive_mpe_coefficients({}), std::invalid_argument);
+  EXPECT_THROW(adaptive_mpe_coefficients({4}), std::invalid_argument);
+  EXPECT_THROW(make_adaptive_mpe_integrator<V2>(resolve_method("DP12"), CountingKepler{&calls}, with_tol(1e-8)),
+               std::invalid_argument);
+  EngineOptions conc;
+  conc.mpe_schedule = MpeSchedule::concurrent;
+  EXPECT_THROW(make_adaptive_mpe_integrator<V2>(def, CountingKepler{&calls}, with_tol(1e-8), conc), std::invalid_argument);
+  auto ai = make_adaptive_mpe_integrator<V2>(def, CountingKepler{&calls}, with_tol(1e-8));
+  State<V2> s = KeplerProblem<double>(0.5).initial_state();
+  EXPECT_THROW(ai.integrate_to(s, 1.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(ai.integrate_to(s, 0.0, nan), std::invalid_argument);
+  State<V2> bad = s;
+  bad.v[1] = nan;
+  EXPECT_THROW(ai.integrate_to(bad, 0.0, 1.0), std::invalid_argument);
+  // A tolerance that cannot be met near a collision: step-size underflow (a runtime_error).
+  State<V2> radial{{1.0, 0.0}, {0.0, 0.0}};
+  auto tight = make_adaptive_mpe_integrator<V2>(def, CountingKepler{&calls}, with_tol(1e-12));
+  EXPECT_THROW(tight.integrate_to(radial, 0.0, 2.0), StepSizeUnderflow);
+}
