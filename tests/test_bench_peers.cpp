@@ -86,7 +86,8 @@ class BenchPeers : public ::testing::Test {
 const std::vector<std::string> kNystromFixed{"VV", "M4", "M6", "M6-5F", "A6", "M8", "KL8", "M10", "SS10", "M12", "DP12"};
 const std::vector<std::string> kOdeintFixed{"odeint velocity_verlet", "odeint sb3a_mclachlan", "odeint sb3a_m4_mclachlan",
                                             "odeint rkf78"};
-const std::vector<std::string> kAdaptive{"DP12-adaptive", "GBS", "odeint dopri5", "odeint bulirsch_stoer"};
+const std::vector<std::string> kAdaptive{"DP12-adaptive", "M10-adaptive",        "M12-adaptive", "M12-adaptive (no comp.)",
+                                         "GBS",           "odeint dopri5", "odeint bulirsch_stoer"};
 
 }  // namespace
 
@@ -227,6 +228,22 @@ TEST_F(BenchPeers, TargetsAreTheFastestRunsBelowTheTarget) {
       EXPECT_DOUBLE_EQ(t["ratio"].get<double>(), t["odeint"]["seconds"].get<double>() / t["nystrom"]["seconds"].get<double>());
     } else {
       EXPECT_TRUE(t["ratio"].is_null());
+    }
+  }
+}
+
+// The second table admits nystrom's uncompensated variants: never slower than the reference table, and
+// the same odeint runs.
+TEST_F(BenchPeers, AnyConfigurationTableIncludesTheVariants) {
+  const auto& ref = (*j_)["targets"];
+  const auto& any = (*j_)["targets_any_configuration"];
+  ASSERT_EQ(any.size(), ref.size());
+  for (std::size_t i = 0; i < any.size(); ++i) {
+    EXPECT_EQ(any[i]["odeint"], ref[i]["odeint"]);
+    if (!ref[i]["nystrom"].is_null()) {
+      ASSERT_FALSE(any[i]["nystrom"].is_null());
+      EXPECT_LE(any[i]["nystrom"]["seconds"].get<double>(), ref[i]["nystrom"]["seconds"].get<double>());
+      EXPECT_GT(any[i]["nystrom_ns_per_force"].get<double>(), 0);
     }
   }
 }

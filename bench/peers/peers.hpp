@@ -30,6 +30,7 @@
 #include <boost/numeric/odeint/stepper/symplectic_rkn_sb3a_m4_mclachlan.hpp>
 
 #include "nystrom/core/state.hpp"
+#include "nystrom/engines/adaptive_mpe.hpp"
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/engines/integrator.hpp"
@@ -219,6 +220,40 @@ inline MethodSpec nystrom_adaptive(const std::string& name, double ecc, long per
   return m;
 }
 
+/// An adaptive multi-product method (engines/adaptive_mpe.hpp), e.g. "M12-adaptive": products in
+/// lockstep, the same start step as DP12-adaptive; compensated summation (the default for double) or
+/// not (then a variant "(no comp.)" that does not count as the library's reference configuration).
+inline MethodSpec nystrom_adaptive_mpe(const std::string& name, double ecc, long periods, bool compensated = true) {
+  const MethodDef def = resolve_method(name);
+  MethodSpec m;
+  m.library = "nystrom";
+  m.name = name;
+  m.label = compensated ? name : name + " (no comp.)";
+  m.adaptive = true;
+  m.order = def.info.order;
+  m.compensated = compensated;
+  m.reference = compensated;
+  m.make = [def, ecc, periods, compensated](ForceCounter* c) -> Prepare {
+    return [def, ecc, periods, c, compensated](double tol) -> Run {
+      AdaptiveOptions opt;
+      opt.tol = tol;
+      opt.h0 = 1e-3;
+      EngineOptions eo;
+      eo.compensated = compensated ? Compensation::on : Compensation::off;
+      auto proto = std::make_shared<AdaptiveMpeIntegrator<Vec2, CountingKepler>>(
+          make_adaptive_mpe_integrator<Vec2>(def, CountingKepler{c}, opt, eo));
+      return [proto, ecc, periods](State<Vec2>& s, long& steps, double& t_end) {
+        auto integ = *proto;
+        s = start(ecc);
+        t_end = period() * static_cast<double>(periods);
+        const AdaptiveStats st = integ.integrate_to(s, 0.0, t_end);
+        steps = st.accepted;
+      };
+    };
+  };
+  return m;
+}
+
 inline MethodSpec nystrom_gbs(double ecc, long periods) {
   MethodSpec m;
   m.library = "nystrom";
@@ -367,6 +402,8 @@ inline std::vector<MethodSpec> peer_methods(double ecc, long periods) {
   for (const char* name : {"VV", "M4", "M6", "M6-5F", "A6", "M8", "KL8", "M10", "SS10", "M12", "DP12"})
     m.push_back(nystrom_fixed(name, ecc, periods));
   m.push_back(nystrom_adaptive("DP12-adaptive", ecc, periods));
+  for (const char* name : {"M10-adaptive", "M12-adaptive"}) m.push_back(nystrom_adaptive_mpe(name, ecc, periods));
+  m.push_back(nystrom_adaptive_mpe("M12-adaptive", ecc, periods, false));
   m.push_back(nystrom_gbs(ecc, periods));
   for (const char* name : {"M8", "SS10", "DP12"}) m.push_back(nystrom_fixed(name, ecc, periods, false));
   m.push_back(odeint_verlet(ecc, periods));
@@ -504,11 +541,12 @@ inline std::vector<PeerRun> sweep_method(const MethodSpec& m, double ecc, const 
 // ---- summaries -----------------------------------------------------------------------------------
 
 /// The fastest successful run of `library` at eccentricity `ecc` with error <= target (reference
-/// configurations only); nullptr if none.
-inline const PeerRun* cheapest(const std::vector<PeerRun>& runs, const std::string& library, double ecc, double target) {
+/// configurations only, unless reference_only is false); nullptr if none.
+inline const PeerRun* cheapest(const std::vector<PeerRun>& runs, const std::string& library, double ecc, double target,
+                               bool reference_only = true) {
   const PeerRun* best = nullptr;
   for (const auto& r : runs)
-    if (r.ok && r.reference && r.library == library && r.ecc == ecc && r.error <= target &&
+    if (r.ok && (r.reference || !reference_only) && r.library == library && r.ecc == ecc && r.error <= target &&
         (!best || r.seconds < best->seconds))
       best = &r;
   return best;
