@@ -9,6 +9,8 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "nystrom/diagnostics/stats.hpp"
@@ -93,6 +95,52 @@ TEST(NBodyForce, ComplexInversePowerIsThePrincipalBranch) {
   EXPECT_NEAR(wi, std::pow(C(-4.0, -0.0), -1.5).imag(), 1e-15);
 }
 
+#if NYSTROM_HAVE_AVX512_KERNEL
+// The SIMD r^{-3/2} (hardware square root and division, a branch for lanes with Re z < 0) against the
+// scalar reference and std::pow, in all four quadrants, on the cut and far from 1; a lane's result does
+// not depend on the other lanes of its vector (a vector with one lane of Re z < 0 takes the other path).
+TEST(NBodyForce, SimdComplexInversePowerAgreesWithTheScalarReference) {
+  if (!nbody_simd_available()) GTEST_SKIP() << "no AVX-512 on this CPU";
+  std::vector<std::pair<double, double>> z = {{3.0, 0.5},   {3.0, -0.5},  {-0.7, 2.0},  {-0.7, -2.0}, {-4.0, 0.0},
+                                              {-4.0, -0.0}, {4.0, 0.0},   {1e-3, 1e-3}, {0.0, 2.0},  {0.0, -2.0},
+                                              {1e60, 3e59}, {-2e-50, 1e-50}, {5e-3, -7e2}, {-1.0, 1e-30}, {2.5, 1e-12}};
+  std::mt19937_64 g(17);
+  for (int k = 0; k < 200; ++k) {
+    const double r = std::exp(40 * (detail::uniform01(g) - 0.5)), t = 6.283185307179586 * detail::uniform01(g);
+    z.emplace_back(r * std::cos(t), r * std::sin(t));
+  }
+  double worst = 0;
+  for (std::size_t k = 0; k + 8 <= z.size(); k += 8) {
+    double a[8], b[8], wr[8], wi[8];
+    for (int l = 0; l < 8; ++l) std::tie(a[l], b[l]) = z[k + l];
+    detail::avx512_complex_inv_pow32_lanes(a, b, wr, wi);
+    for (int l = 0; l < 8; ++l) {
+      // Reference: the scalar formula in long double (64-bit mantissa), and std::pow for the branch.
+      long double lr, li;
+      detail::complex_inv_pow32<long double>(a[l], b[l], lr, li);
+      const C ref = std::pow(C(a[l], b[l]), -1.5);
+      const double mag = std::abs(ref);
+      const double err = static_cast<double>(std::hypot(wr[l] - lr, wi[l] - li)) / mag;
+      EXPECT_LT(err, 4 * 0x1p-52) << a[l] << " " << b[l];  // a few ulp
+      EXPECT_NEAR(wr[l], ref.real(), 1e-14 * mag) << a[l] << " " << b[l];
+      EXPECT_NEAR(wi[l], ref.imag(), 1e-14 * mag) << a[l] << " " << b[l];
+      worst = std::max(worst, err);
+      // The same z alone in an otherwise right-half-plane (or left-half-plane) vector: the same bits.
+      for (double fill : {1.0, -1.0}) {
+        double a1[8], b1[8], vr[8], vi[8];
+        for (int m = 0; m < 8; ++m) a1[m] = fill, b1[m] = 0.25;
+        a1[3] = a[l];
+        b1[3] = b[l];
+        detail::avx512_complex_inv_pow32_lanes(a1, b1, vr, vi);
+        EXPECT_EQ(vr[3], wr[l]);
+        EXPECT_EQ(vi[3], wi[l]);
+      }
+    }
+  }
+  EXPECT_GT(worst, 0.0);  // the comparison is not vacuous
+}
+#endif
+
 // The complex force is the analytic continuation: Im a(q + i d u) / d is the directional derivative of the
 // real force (complex-step differentiation), Re a(q + i d u) = a(q) + O(d^2).
 TEST(NBodyForce, ComplexForceIsTheAnalyticContinuation) {
@@ -150,6 +198,80 @@ TEST(NBodyForce, SimdKernelAgreesWithGenericKernel) {
       f(qc, bs);
       EXPECT_LT(max_rel_diff(bg, bs), 1e-13) << "complex, n = " << n << " eps2 = " << eps2;
     }
+  }
+}
+
+// Imaginary parts large enough that Re r^2 < 0 for some pairs (the other branch of the SIMD r^{-3/2}).
+TEST(NBodyForce, SimdComplexKernelAgreesFarFromTheRealAxis) {
+  if (!nbody_simd_available()) GTEST_SKIP() << "no AVX-512 on this CPU";
+  auto p = plummer_sphere<double>(300, 23);
+  const auto qc = complexify(p.s.q, 0.6, 29);
+  long left = 0;
+  for (std::size_t i = 0; i < 300; ++i)
+    for (std::size_t j = 0; j < 300; ++j) {
+      C r2 = 0;
+      for (std::size_t c = 0; c < 3; ++c) r2 += (qc[c * 300 + j] - qc[c * 300 + i]) * (qc[c * 300 + j] - qc[c * 300 + i]);
+      left += (r2.real() + 1e-4 < 0) ? 1 : 0;
+    }
+  EXPECT_GT(left, 1000);  // the test covers the branch
+  for (double eps2 : {0.0, 1e-4}) {
+    NBodyForce<double> f(p.m, eps2);
+    std::vector<C> bg, bs;
+    f.kernel = NBodyKernel::generic;
+    f(qc, bg);
+    f.kernel = NBodyKernel::simd;
+    f(qc, bs);
+    EXPECT_LT(max_rel_diff(bg, bs), 1e-12) << "eps2 = " << eps2;
+  }
+}
+
+// The largest blocks (B = 256 from N = 8192 on, the size of the complex kernel's stack buffer), a padded
+// last block: sampled particles against direct sums with the scalar reference.
+TEST(NBodyForce, SimdKernelsAgreeWithDirectSumsOnLargeBlocks) {
+  if (!nbody_simd_available()) GTEST_SKIP() << "no AVX-512 on this CPU";
+  const std::size_t n = 8200;
+  ASSERT_EQ(detail::nbody_block(n), 256u);
+  auto p = plummer_sphere<double>(n, 31, [] {
+    PlummerOptions o;
+    o.exact_energy = false;
+    return o;
+  }());
+  const auto qc = complexify(p.s.q, 1e-3, 37);
+  for (double eps2 : {0.0, 1.0 / (double(n) * double(n))}) {
+    NBodyForce<double> f(p.m, eps2);
+    f.kernel = NBodyKernel::simd;
+    std::vector<double> a;
+    std::vector<C> ac;
+    f(p.s.q, a);
+    f(qc, ac);
+    double dr = 0, sr = 0, dc = 0, sc = 0;
+    for (std::size_t i = 0; i < n; i += 97) {
+      double s[3] = {0, 0, 0};
+      C t[3] = {0, 0, 0};
+      for (std::size_t j = 0; j < n; ++j) {
+        if (j == i) continue;
+        double d[3];
+        C e[3];
+        for (std::size_t c = 0; c < 3; ++c) {
+          d[c] = p.s.q[c * n + j] - p.s.q[c * n + i];
+          e[c] = qc[c * n + j] - qc[c * n + i];
+        }
+        const double w = detail::mass_inv_r3(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2, p.m[j]);
+        const C v = detail::mass_inv_r3(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + eps2, p.m[j]);
+        for (std::size_t c = 0; c < 3; ++c) {
+          s[c] += w * d[c];
+          t[c] += v * e[c];
+        }
+      }
+      for (std::size_t c = 0; c < 3; ++c) {
+        dr = std::max(dr, std::abs(s[c] - a[c * n + i]));
+        sr = std::max(sr, std::abs(s[c]));
+        dc = std::max(dc, std::abs(t[c] - ac[c * n + i]));
+        sc = std::max(sc, std::abs(t[c]));
+      }
+    }
+    EXPECT_LT(dr / sr, 1e-13) << "eps2 = " << eps2;
+    EXPECT_LT(dc / sc, 1e-13) << "eps2 = " << eps2;
   }
 }
 

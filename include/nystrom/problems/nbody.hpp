@@ -12,9 +12,12 @@
 // Kernels (NBodyForce::kernel):
 //   * generic: every type; each particle's sum over j in increasing order, OpenMP across particles.
 //   * simd (double and std::complex<double> on x86-64 with AVX-512F, chosen at run time): pair symmetry
-//     (each pair computed once, Newton's third law), AVX-512 across 8 partners, r^{-3/2} from the
+//     (each pair computed once, Newton's third law), AVX-512 across 8 partners. Real: r^{-3/2} from the
 //     hardware estimate vrsqrt14pd refined by one polynomial correction to full double accuracy (a few
-//     ulp; the division and square-root units are several times slower on these machines). Particles
+//     ulp; the division and square-root units are several times slower than this short loop). Complex:
+//     z^{-3/2} (z = r^2 + eps^2) with two hardware square roots and one division, whose latency is hidden
+//     by computing z^{-3/2} for a whole block of partners of two rows first and accumulating after
+//     (a few ulp; 2.6-3x the real kernel's time per pair at N = 10 000, against 4.5x before). Particles
 //     are grouped in blocks of B (B depends on N only); the block pairs are visited in the rounds of a
 //     round-robin tournament, so that within a round no two tiles touch the same block: the tiles of a
 //     round run in parallel (OpenMP) and every particle receives its contributions in the same order
@@ -82,34 +85,31 @@ inline int nbody_max_threads() {
 
 namespace detail {
 
-/// (re + i im)^{-3/2} on the principal branch, written with reciprocal square roots of real numbers
-/// only (the same formula as the SIMD kernel):
-///   rho = |z|, u = 1/rho, p = rho + |a|, g = 1/sqrt(2p);
-///   z^{-1/2} = g u (p - i b) for a >= 0,  g u (|b| - i sign(b) p) for a < 0;
-///   z^{-3/2} = z^{-1/2} conj(z) u^2.
+/// (a + i b)^{-3/2} on the principal branch (the branch cut on the negative real axis, the sign of a zero b
+/// picking its side), with real square roots only; the same formula as the SIMD kernel:
+///   rho = |z| = sqrt(a^2 + b^2),  p = rho + |a|,  k = 1 / sqrt(2 p rho^2),  f = k / rho^2 (= 2 p k^3);
+///   z^{-1/2} = k (p - i b) for a >= 0,  k (|b| - i s p) for a < 0 (s = sign of b, -1 for b = -0);
+///   z^{-3/2} = z^{-1/2} conj(z) / rho^2, i.e.
+///     a >= 0:  ((p a - b^2) - i b (a + p)) f,      a < 0:  (|b| (a - p) - i s (b^2 + p a)) f.
+/// No cancellation in p, a + p (a >= 0) or a - p (a < 0).
 template <class T>
 void complex_inv_pow32(const T& a, const T& b, T& wr, T& wi) {
   using std::abs;
   using std::copysign;
   using std::sqrt;
-  const T rho2 = a * a + b * b;
-  const T u = T(1) / sqrt(rho2);
-  const T rho = rho2 * u;
+  const T bb = b * b;
+  const T rho2 = a * a + bb;
+  const T rho = sqrt(rho2);
   const T p = rho + abs(a);
-  const T g = T(1) / sqrt(T(2) * p);
-  const T k = g * u;
-  T sr, si;  // z^{-1/2} / k
+  const T k = T(1) / (sqrt(T(2) * p) * rho);
+  const T f = k / rho2;
   if (a >= T(0)) {
-    sr = p;
-    si = -b;
+    wr = (p * a - bb) * f;
+    wi = -(b * (a + p)) * f;
   } else {
-    sr = abs(b);
-    si = -copysign(p, b);
+    wr = abs(b) * (a - p) * f;
+    wi = -copysign(T(1), b) * (bb + p * a) * f;
   }
-  // (sr + i si)(a - i b) k u^2
-  const T f = k * u * u;
-  wr = (sr * a + si * b) * f;
-  wi = (si * a - sr * b) * f;
 }
 
 /// m * (r2)^{-3/2} for a real or complex r2 (real mass m); zero when r2 == 0.
@@ -130,7 +130,7 @@ S mass_inv_r3(const S& r2, const real_t<S>& m) {
 /// Block size of the SIMD kernel: a multiple of 8 that depends on N only.
 inline std::size_t nbody_block(std::size_t n) {
   std::size_t b = (n / 32 + 7) / 8 * 8;
-  return std::clamp<std::size_t>(b, 64, 256);
+  return std::clamp<std::size_t>(b, 64, 256);  // 256: complex_max_block
 }
 
 /// Round r (0 <= r < P-1) of the circle-method round-robin over P (even) players: pair k of the round.
@@ -179,37 +179,56 @@ NYSTROM_TARGET_AVX512 inline __m512d avx512_rsqrt(__m512d x) {
 }
 
 // Bitwise operations on doubles with AVX-512F only (the _pd forms need AVX512DQ).
-NYSTROM_TARGET_AVX512 inline __m512d avx512_and(__m512d a, __m512d b) {
-  return _mm512_castsi512_pd(_mm512_maskz_and_epi64(0xFF, _mm512_castpd_si512(a), _mm512_castpd_si512(b)));
-}
 NYSTROM_TARGET_AVX512 inline __m512d avx512_andnot(__m512d a, __m512d b) {
   return _mm512_castsi512_pd(_mm512_maskz_andnot_epi64(0xFF, _mm512_castpd_si512(a), _mm512_castpd_si512(b)));
-}
-NYSTROM_TARGET_AVX512 inline __m512d avx512_or(__m512d a, __m512d b) {
-  return _mm512_castsi512_pd(_mm512_maskz_or_epi64(0xFF, _mm512_castpd_si512(a), _mm512_castpd_si512(b)));
 }
 NYSTROM_TARGET_AVX512 inline __m512d avx512_xor(__m512d a, __m512d b) {
   return _mm512_castsi512_pd(_mm512_maskz_xor_epi64(0xFF, _mm512_castpd_si512(a), _mm512_castpd_si512(b)));
 }
 
-/// (a + i b)^{-3/2}, the formula of complex_inv_pow32.
+/// The a >= 0 formula: wr = (p a - b^2) f, wi = -(a + p) b f, f = 1 / (rho^2 sqrt(2 p rho^2)) (p = rho + |a|).
+NYSTROM_TARGET_AVX512 inline void avx512_cinv_right(__m512d a, __m512d b, __m512d bb, __m512d rho2, __m512d p,
+                                                    __m512d& wr, __m512d& wi, __m512d& f) {
+  const __m512d p2 = _mm512_add_pd(p, p);
+  const __m512d y = _mm512_maskz_sqrt_pd(0xFF, _mm512_mul_pd(p2, rho2));
+  f = _mm512_div_pd(_mm512_set1_pd(1.0), _mm512_mul_pd(rho2, y));
+  wr = _mm512_mul_pd(_mm512_fmsub_pd(p, a, bb), f);
+  wi = _mm512_mul_pd(_mm512_mul_pd(b, f), _mm512_fnmsub_pd(a, _mm512_set1_pd(1.0), p));  // -(a + p)
+}
+
+/// (a + i b)^{-3/2}, the formula of complex_inv_pow32, with the hardware square root and division
+/// (correctly rounded). Their unit works beside the FMA units and is far from saturated here: two square
+/// roots and one division per 8 pairs replace about 20 FMA-unit operations of two refined vrsqrt14pd
+/// estimates. Lanes with a < 0 (never seen with near-real positions: Re r^2 = eps^2 + |Re d|^2 - |Im d|^2)
+/// take a branch that blends in the other half-plane's formula; lanes with a >= 0 give the same bits on
+/// both paths. 2 p rho^2 (2 to 4 |z|^3) and rho^2 sqrt(2 p rho^2) (1.4 to 2 |z|^{7/2}) must stay finite and
+/// normal: |z| = |r^2 + eps^2| within about [1e-87, 1e87] (the generic kernel has no such limit).
 NYSTROM_TARGET_AVX512 inline void avx512_complex_inv_pow32(__m512d a, __m512d b, __m512d& wr, __m512d& wi) {
-  const __m512d sign = _mm512_set1_pd(-0.0);
-  const __m512d rho2 = _mm512_fmadd_pd(a, a, _mm512_mul_pd(b, b));
-  const __m512d u = avx512_rsqrt(rho2);
-  const __m512d rho = _mm512_mul_pd(rho2, u);
-  const __m512d absa = avx512_andnot(sign, a);
-  const __m512d p = _mm512_add_pd(rho, absa);
-  const __m512d g = avx512_rsqrt(_mm512_add_pd(p, p));
+  const __m512d bb = _mm512_mul_pd(b, b);
+  const __m512d rho2 = _mm512_fmadd_pd(a, a, bb);
+  const __m512d rho = _mm512_maskz_sqrt_pd(0xFF, rho2);  // maskz: GCC 12 warns on _mm512_sqrt_pd
   const __mmask8 neg = _mm512_cmp_pd_mask(a, _mm512_setzero_pd(), _CMP_LT_OQ);
-  // sr = a >= 0 ? p : |b|;  si = a >= 0 ? -b : -copysign(p, b)
-  const __m512d absb = avx512_andnot(sign, b);
-  const __m512d sr = _mm512_mask_blend_pd(neg, p, absb);
-  const __m512d cps = avx512_or(p, avx512_and(sign, b));
-  const __m512d si = avx512_xor(sign, _mm512_mask_blend_pd(neg, b, cps));
-  const __m512d f = _mm512_mul_pd(_mm512_mul_pd(g, u), _mm512_mul_pd(u, u));
-  wr = _mm512_mul_pd(_mm512_fmadd_pd(sr, a, _mm512_mul_pd(si, b)), f);
-  wi = _mm512_mul_pd(_mm512_fmsub_pd(si, a, _mm512_mul_pd(sr, b)), f);
+  __m512d f;
+  if (neg == 0) {
+    avx512_cinv_right(a, b, bb, rho2, _mm512_add_pd(rho, a), wr, wi, f);
+    return;
+  }
+  const __m512d sign = _mm512_set1_pd(-0.0);
+  const __m512d p = _mm512_add_pd(rho, avx512_andnot(sign, a));  // rho + |a|
+  avx512_cinv_right(a, b, bb, rho2, p, wr, wi, f);
+  // a < 0: wr = |b| (a - p) f, wi = -s (b^2 + p a) f (s = sign of b).
+  const __m512d nr = _mm512_mul_pd(_mm512_mul_pd(avx512_andnot(sign, b), f), _mm512_sub_pd(a, p));
+  const __m512d ni = avx512_xor(_mm512_mul_pd(_mm512_fmadd_pd(p, a, bb), f), avx512_andnot(b, sign));
+  wr = _mm512_mask_blend_pd(neg, wr, nr);
+  wi = _mm512_mask_blend_pd(neg, wi, ni);
+}
+
+/// avx512_complex_inv_pow32 on 8 lanes in memory (for tests: the caller checks nbody_simd_available()).
+NYSTROM_TARGET_AVX512 inline void avx512_complex_inv_pow32_lanes(const double* a, const double* b, double* wr, double* wi) {
+  __m512d r, i;
+  avx512_complex_inv_pow32(_mm512_loadu_pd(a), _mm512_loadu_pd(b), r, i);
+  _mm512_storeu_pd(wr, r);
+  _mm512_storeu_pd(wi, i);
 }
 
 /// Padded SoA buffers of the SIMD kernel (pointers to the arrays of positions, masses, accelerations).
@@ -299,116 +318,145 @@ struct ComplexTileData {
   double *axr, *axi, *ayr, *ayi, *azr, *azi;
 };
 
-/// Complex separation d = q_j - q_i, r2 = d.d + eps2 (complex), w = r2^{-3/2}; returns the lanes with r2 != 0.
-NYSTROM_TARGET_AVX512 inline __mmask8 avx512_complex_w(const ComplexTileData& d, std::size_t j, __m512d qxr, __m512d qxi,
-                                                   __m512d qyr, __m512d qyi, __m512d qzr, __m512d qzi, __m512d e2,
-                                                   __m512d* dd, __m512d& wr, __m512d& wi) {
-  dd[0] = _mm512_sub_pd(_mm512_loadu_pd(d.xr + j), qxr);
-  dd[1] = _mm512_sub_pd(_mm512_loadu_pd(d.xi + j), qxi);
-  dd[2] = _mm512_sub_pd(_mm512_loadu_pd(d.yr + j), qyr);
-  dd[3] = _mm512_sub_pd(_mm512_loadu_pd(d.yi + j), qyi);
-  dd[4] = _mm512_sub_pd(_mm512_loadu_pd(d.zr + j), qzr);
-  dd[5] = _mm512_sub_pd(_mm512_loadu_pd(d.zi + j), qzi);
-  __m512d a = _mm512_fmadd_pd(dd[0], dd[0], e2);
-  a = _mm512_fmadd_pd(dd[2], dd[2], a);
-  a = _mm512_fmadd_pd(dd[4], dd[4], a);
-  a = _mm512_fnmadd_pd(dd[1], dd[1], a);
-  a = _mm512_fnmadd_pd(dd[3], dd[3], a);
-  a = _mm512_fnmadd_pd(dd[5], dd[5], a);
+/// Complex separation d = q_j - q_i of row q (6 broadcast coordinates) and the 8 partners at j.
+NYSTROM_TARGET_AVX512 inline void avx512_complex_d(const ComplexTileData& d, std::size_t j, const __m512d* q, __m512d* dd) {
+  dd[0] = _mm512_sub_pd(_mm512_loadu_pd(d.xr + j), q[0]);
+  dd[1] = _mm512_sub_pd(_mm512_loadu_pd(d.xi + j), q[1]);
+  dd[2] = _mm512_sub_pd(_mm512_loadu_pd(d.yr + j), q[2]);
+  dd[3] = _mm512_sub_pd(_mm512_loadu_pd(d.yi + j), q[3]);
+  dd[4] = _mm512_sub_pd(_mm512_loadu_pd(d.zr + j), q[4]);
+  dd[5] = _mm512_sub_pd(_mm512_loadu_pd(d.zi + j), q[5]);
+}
+
+/// w = r2^{-3/2} for the 8 partners at j of row q, r2 = d.d + eps2 (complex); lanes with r2 == 0 give
+/// w = 0 when Masked.
+template <bool Masked>
+NYSTROM_TARGET_AVX512 inline void avx512_complex_w(const ComplexTileData& d, std::size_t j, const __m512d* q, __m512d e2,
+                                                   __m512d& wr, __m512d& wi) {
+  __m512d dd[6];
+  avx512_complex_d(d, j, q, dd);
+  // Re r2 in two chains (x and z; y), to shorten the dependency chain.
+  __m512d a = _mm512_fnmadd_pd(dd[1], dd[1], _mm512_fmadd_pd(dd[0], dd[0], e2));
+  a = _mm512_fnmadd_pd(dd[5], dd[5], _mm512_fmadd_pd(dd[4], dd[4], a));
+  a = _mm512_add_pd(a, _mm512_fnmadd_pd(dd[3], dd[3], _mm512_mul_pd(dd[2], dd[2])));
   __m512d b = _mm512_mul_pd(dd[0], dd[1]);
   b = _mm512_fmadd_pd(dd[2], dd[3], b);
   b = _mm512_fmadd_pd(dd[4], dd[5], b);
   b = _mm512_add_pd(b, b);
   avx512_complex_inv_pow32(a, b, wr, wi);
-  return _mm512_cmp_pd_mask(a, _mm512_setzero_pd(), _CMP_NEQ_OQ) | _mm512_cmp_pd_mask(b, _mm512_setzero_pd(), _CMP_NEQ_OQ);
+  if constexpr (Masked) {
+    const __mmask8 nz =
+        _mm512_cmp_pd_mask(a, _mm512_setzero_pd(), _CMP_NEQ_OQ) | _mm512_cmp_pd_mask(b, _mm512_setzero_pd(), _CMP_NEQ_OQ);
+    wr = _mm512_maskz_mov_pd(nz, wr);
+    wi = _mm512_maskz_mov_pd(nz, wi);
+  }
 }
 
+/// The largest block of the complex kernels (nbody_block's bound): their buffer of w is on the stack.
+inline constexpr std::size_t complex_max_block = 256;
+
+/// First pass over a block of partners (j0 .. j0 + B - 1) for rows i and i + 1: w of every pair, stored as
+/// [wr_i, wi_i, wr_k, wi_k] per 8 partners. The pass has no dependency from one group of 8 partners to the
+/// next, so the processor overlaps the long latency of the square roots and divisions of several groups;
+/// interleaved with the accumulation (one pass) it ran 1.6x slower.
+template <bool Masked>
+NYSTROM_TARGET_AVX512 inline void avx512_complex_w_rows(const ComplexTileData& d, const __m512d* qi, const __m512d* qk,
+                                                        std::size_t j0, std::size_t B, __m512d e2, double* wbuf) {
+  for (std::size_t j = j0; j < j0 + B; j += 8, wbuf += 32) {
+    __m512d wr, wi, vr, vi;
+    avx512_complex_w<Masked>(d, j, qi, e2, wr, wi);
+    avx512_complex_w<Masked>(d, j, qk, e2, vr, vi);
+    _mm512_store_pd(wbuf, wr);
+    _mm512_store_pd(wbuf + 8, wi);
+    _mm512_store_pd(wbuf + 16, vr);
+    _mm512_store_pd(wbuf + 24, vi);
+  }
+}
+
+/// P = w d for the three complex components (P[2c] + i P[2c+1] = (wr + i wi)(d[2c] + i d[2c+1])).
+NYSTROM_TARGET_AVX512 inline void avx512_complex_wd(const double* w, const __m512d* dd, __m512d* P) {
+  const __m512d wr = _mm512_load_pd(w), wi = _mm512_load_pd(w + 8);
+  for (int c = 0; c < 3; ++c) {
+    P[2 * c] = _mm512_fnmadd_pd(wi, dd[2 * c + 1], _mm512_mul_pd(wr, dd[2 * c]));
+    P[2 * c + 1] = _mm512_fmadd_pd(wi, dd[2 * c], _mm512_mul_pd(wr, dd[2 * c + 1]));
+  }
+}
+
+NYSTROM_TARGET_AVX512 inline void avx512_complex_row(const ComplexTileData& d, std::size_t i, __m512d* q) {
+  q[0] = _mm512_set1_pd(d.xr[i]);
+  q[1] = _mm512_set1_pd(d.xi[i]);
+  q[2] = _mm512_set1_pd(d.yr[i]);
+  q[3] = _mm512_set1_pd(d.yi[i]);
+  q[4] = _mm512_set1_pd(d.zr[i]);
+  q[5] = _mm512_set1_pd(d.zi[i]);
+}
+
+/// Contributions within one block: rows i, i+1 at a time, each summing over all j of the block in order
+/// (i's own term is zero: d = 0, or masked).
 template <bool Masked>
 NYSTROM_TARGET_AVX512 inline void avx512_diag_complex(const ComplexTileData& d, std::size_t i0, std::size_t B, double eps2) {
   const __m512d e2 = _mm512_set1_pd(eps2);
-  for (std::size_t i = i0; i < i0 + B; ++i) {
-    const __m512d qxr = _mm512_set1_pd(d.xr[i]), qxi = _mm512_set1_pd(d.xi[i]), qyr = _mm512_set1_pd(d.yr[i]),
-                  qyi = _mm512_set1_pd(d.yi[i]), qzr = _mm512_set1_pd(d.zr[i]), qzi = _mm512_set1_pd(d.zi[i]);
-    __m512d s[6];
-    for (auto& x : s) x = _mm512_setzero_pd();
-    for (std::size_t j = i0; j < i0 + B; j += 8) {
-      __m512d dd[6], wr, wi;
-      const __mmask8 nz = avx512_complex_w(d, j, qxr, qxi, qyr, qyi, qzr, qzi, e2, dd, wr, wi);
+  double* const out[6] = {d.axr, d.axi, d.ayr, d.ayi, d.azr, d.azi};
+  alignas(64) double wbuf[4 * complex_max_block];
+  for (std::size_t i = i0; i < i0 + B; i += 2) {
+    __m512d qi[6], qk[6], s[6], t[6];
+    avx512_complex_row(d, i, qi);
+    avx512_complex_row(d, i + 1, qk);
+    avx512_complex_w_rows<Masked>(d, qi, qk, i0, B, e2, wbuf);
+    for (int c = 0; c < 6; ++c) s[c] = t[c] = _mm512_setzero_pd();
+    const double* w = wbuf;
+    for (std::size_t j = i0; j < i0 + B; j += 8, w += 32) {
+      __m512d dd[6], ee[6], P[6], Q[6];
+      avx512_complex_d(d, j, qi, dd);
+      avx512_complex_d(d, j, qk, ee);
+      avx512_complex_wd(w, dd, P);
+      avx512_complex_wd(w + 16, ee, Q);
       const __m512d mj = _mm512_loadu_pd(d.m + j);
-      wr = _mm512_mul_pd(wr, mj);
-      wi = _mm512_mul_pd(wi, mj);
-      if constexpr (Masked) {
-        wr = _mm512_maskz_mov_pd(nz, wr);
-        wi = _mm512_maskz_mov_pd(nz, wi);
-      } else {
-        (void)nz;
-      }
-      for (int c = 0; c < 3; ++c) {
-        s[2 * c] = _mm512_fnmadd_pd(wi, dd[2 * c + 1], _mm512_fmadd_pd(wr, dd[2 * c], s[2 * c]));
-        s[2 * c + 1] = _mm512_fmadd_pd(wi, dd[2 * c], _mm512_fmadd_pd(wr, dd[2 * c + 1], s[2 * c + 1]));
+      for (int c = 0; c < 6; ++c) {
+        s[c] = _mm512_fmadd_pd(mj, P[c], s[c]);
+        t[c] = _mm512_fmadd_pd(mj, Q[c], t[c]);
       }
     }
-    d.axr[i] += avx512_sum(s[0]);
-    d.axi[i] += avx512_sum(s[1]);
-    d.ayr[i] += avx512_sum(s[2]);
-    d.ayi[i] += avx512_sum(s[3]);
-    d.azr[i] += avx512_sum(s[4]);
-    d.azi[i] += avx512_sum(s[5]);
+    for (int c = 0; c < 6; ++c) {
+      out[c][i] += avx512_sum(s[c]);
+      out[c][i + 1] += avx512_sum(t[c]);
+    }
   }
 }
 
 /// Both directions of the complex interactions between block I (at i0) and block J (at j0), each pair
-/// once. Two rows i, i+1 at a time, as in avx512_pair_real: the loads of block J and the read-modify-write
-/// of its accelerations serve two rows, and the two rows are independent dependency chains.
+/// once. Two rows i, i+1 at a time, as in avx512_pair_real: w of both rows and the whole block J first
+/// (avx512_complex_w_rows), then, with P = w_ij d_ij, a_i += m_j P and a_j -= m_i P (then row i+1): the
+/// loads of block J and the read-modify-write of its accelerations serve two rows.
 template <bool Masked>
 NYSTROM_TARGET_AVX512 inline void avx512_pair_complex(const ComplexTileData& d, std::size_t i0, std::size_t j0,
                                                       std::size_t B, double eps2) {
   const __m512d e2 = _mm512_set1_pd(eps2);
-  double* __restrict const axr = d.axr;
-  double* __restrict const axi = d.axi;
-  double* __restrict const ayr = d.ayr;
-  double* __restrict const ayi = d.ayi;
-  double* __restrict const azr = d.azr;
-  double* __restrict const azi = d.azi;
-  double* const out[6] = {axr, axi, ayr, ayi, azr, azi};
+  const ComplexTileData dl = d;  // local copy: the stores below cannot alias its pointers
+  double* const out[6] = {dl.axr, dl.axi, dl.ayr, dl.ayi, dl.azr, dl.azi};
+  alignas(64) double wbuf[4 * complex_max_block];
   for (std::size_t i = i0; i < i0 + B; i += 2) {
     const std::size_t k = i + 1;
-    __m512d s[6], t[6];
+    __m512d qi[6], qk[6], s[6], t[6];
+    avx512_complex_row(dl, i, qi);
+    avx512_complex_row(dl, k, qk);
+    avx512_complex_w_rows<Masked>(dl, qi, qk, j0, B, e2, wbuf);
+    const __m512d mi = _mm512_set1_pd(dl.m[i]), mk = _mm512_set1_pd(dl.m[k]);
     for (int c = 0; c < 6; ++c) s[c] = t[c] = _mm512_setzero_pd();
-    for (std::size_t j = j0; j < j0 + B; j += 8) {
-      __m512d dd[6], ee[6], wr, wi, vr, vi;
-      const __mmask8 nz = avx512_complex_w(d, j, _mm512_set1_pd(d.xr[i]), _mm512_set1_pd(d.xi[i]),
-                                           _mm512_set1_pd(d.yr[i]), _mm512_set1_pd(d.yi[i]), _mm512_set1_pd(d.zr[i]),
-                                           _mm512_set1_pd(d.zi[i]), e2, dd, wr, wi);
-      const __mmask8 mz = avx512_complex_w(d, j, _mm512_set1_pd(d.xr[k]), _mm512_set1_pd(d.xi[k]),
-                                           _mm512_set1_pd(d.yr[k]), _mm512_set1_pd(d.yi[k]), _mm512_set1_pd(d.zr[k]),
-                                           _mm512_set1_pd(d.zi[k]), e2, ee, vr, vi);
-      if constexpr (Masked) {
-        wr = _mm512_maskz_mov_pd(nz, wr);
-        wi = _mm512_maskz_mov_pd(nz, wi);
-        vr = _mm512_maskz_mov_pd(mz, vr);
-        vi = _mm512_maskz_mov_pd(mz, vi);
-      } else {
-        (void)nz, (void)mz;
-      }
-      const __m512d mj = _mm512_loadu_pd(d.m + j), mi = _mm512_set1_pd(d.m[i]), mk = _mm512_set1_pd(d.m[k]);
-      const __m512d wjr = _mm512_mul_pd(wr, mj), wji = _mm512_mul_pd(wi, mj);
-      const __m512d wir = _mm512_mul_pd(wr, mi), wii = _mm512_mul_pd(wi, mi);
-      const __m512d vjr = _mm512_mul_pd(vr, mj), vji = _mm512_mul_pd(vi, mj);
-      const __m512d vkr = _mm512_mul_pd(vr, mk), vki = _mm512_mul_pd(vi, mk);
-      for (int c = 0; c < 3; ++c) {
-        const __m512d dr = dd[2 * c], di = dd[2 * c + 1], er = ee[2 * c], ei = ee[2 * c + 1];
-        s[2 * c] = _mm512_fnmadd_pd(wji, di, _mm512_fmadd_pd(wjr, dr, s[2 * c]));
-        s[2 * c + 1] = _mm512_fmadd_pd(wji, dr, _mm512_fmadd_pd(wjr, di, s[2 * c + 1]));
-        t[2 * c] = _mm512_fnmadd_pd(vji, ei, _mm512_fmadd_pd(vjr, er, t[2 * c]));
-        t[2 * c + 1] = _mm512_fmadd_pd(vji, er, _mm512_fmadd_pd(vjr, ei, t[2 * c + 1]));
-        // a_j -= m_i w_ij d_ij, then row i+1: the same order as one row at a time.
-        double* pr = out[2 * c] + j;
-        double* pi = out[2 * c + 1] + j;
-        const __m512d ar = _mm512_fmadd_pd(wii, di, _mm512_fnmadd_pd(wir, dr, _mm512_loadu_pd(pr)));
-        const __m512d ai = _mm512_fnmadd_pd(wii, dr, _mm512_fnmadd_pd(wir, di, _mm512_loadu_pd(pi)));
-        _mm512_storeu_pd(pr, _mm512_fmadd_pd(vki, ei, _mm512_fnmadd_pd(vkr, er, ar)));
-        _mm512_storeu_pd(pi, _mm512_fnmadd_pd(vki, er, _mm512_fnmadd_pd(vkr, ei, ai)));
+    const double* w = wbuf;
+    for (std::size_t j = j0; j < j0 + B; j += 8, w += 32) {
+      __m512d dd[6], ee[6], P[6], Q[6];
+      avx512_complex_d(dl, j, qi, dd);
+      avx512_complex_d(dl, j, qk, ee);
+      avx512_complex_wd(w, dd, P);
+      avx512_complex_wd(w + 16, ee, Q);
+      const __m512d mj = _mm512_loadu_pd(dl.m + j);
+      for (int c = 0; c < 6; ++c) {
+        s[c] = _mm512_fmadd_pd(mj, P[c], s[c]);
+        t[c] = _mm512_fmadd_pd(mj, Q[c], t[c]);
+        // a_j -= m_i P_ij, then row i+1: the same order as one row at a time.
+        double* pa = out[c] + j;
+        _mm512_storeu_pd(pa, _mm512_fnmadd_pd(mk, Q[c], _mm512_fnmadd_pd(mi, P[c], _mm512_loadu_pd(pa))));
       }
     }
     for (int c = 0; c < 6; ++c) {
