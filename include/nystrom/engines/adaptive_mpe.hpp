@@ -524,6 +524,11 @@ class AdaptiveMpeIntegrator {
       if (t + h * real_type(1.01) >= t1) {
         h = t1 - t;
         last = true;
+      } else {
+        // A step whose end time is exactly representable: the time reached is then the sum of the
+        // steps taken, not its rounding (over 10^4 steps to t = 600 that rounding, ~1e-11 in time,
+        // was the round-off floor of the position error on Kepler).
+        h = (t + h) - t;
       }
       if (!(h > tiny) || !(h > real_type(0))) {
         store();
