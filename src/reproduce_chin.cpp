@@ -157,7 +157,7 @@ TargetResult fig1(const Context& ctx) {
 
   // table: e_P / 1e4 at n = 5000 for every e
   std::string t = fmt::format("e_P = dtheta / h^4 at n = {} steps per period:\n\n| e |", n_final);
-  for (const auto& m : methods) t += " " + label_of(m) + " |";
+  for (const auto& m : methods) t += fmt::format(" {} |", label_of(m));
   t += "\n|---|";
   for (std::size_t i = 0; i < methods.size(); ++i) t += "---|";
   t += "\n";
@@ -245,7 +245,7 @@ std::string errors_table(const std::vector<GridRow>& rows, const std::vector<std
   t += "\n";
   for (const auto& m : methods) {
     t += fmt::format("| {} | {} |", label_of(m), resolve_method(m).info.forces_per_step);
-    for (double n : at) t += " " + fmt_g(error_at(rows, m, n)) + " |";
+    for (double n : at) t += fmt::format(" {} |", fmt_g(error_at(rows, m, n)));
     t += "\n";
   }
   return t;

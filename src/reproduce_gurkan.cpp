@@ -115,7 +115,7 @@ std::string orders_table(const LocalErrResult& r, const std::vector<std::string>
   t += "\n";
   for (const auto& m : methods) {
     t += fmt::format("| {} | {} | {} |", label_of(m), resolve_method(m).info.order, fmt_g(observed_order(r, m)));
-    for (double h : hs) t += " " + fmt_g(iqr_at(r, m, h), 3) + " |";
+    for (double h : hs) t += fmt::format(" {} |", fmt_g(iqr_at(r, m, h), 3));
     t += "\n";
   }
   return t;

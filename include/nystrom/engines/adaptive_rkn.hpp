@@ -54,7 +54,7 @@
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/methods/method.hpp"
-#include "nystrom/methods/refine.hpp"
+#include "nystrom/methods/method_data.hpp"
 
 namespace nystrom {
 

@@ -15,7 +15,7 @@
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/engines/splitting.hpp"
 #include "nystrom/methods/method.hpp"
-#include "nystrom/methods/refine.hpp"
+#include "nystrom/methods/method_data.hpp"
 
 namespace nystrom {
 

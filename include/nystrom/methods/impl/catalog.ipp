@@ -1,0 +1,167 @@
+// Definitions of the catalog (declared in methods/catalog.hpp): every coefficient table, the registry and
+// the specification parser. Header-only builds include this file from catalog.hpp (inline); with
+// NYSTROM_SEPARATE_COMPILATION it is compiled once, in lib/nystrom.cpp (see core/config.hpp).
+#pragma once
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "nystrom/analysis/method_file.hpp"
+#include "nystrom/methods/blanes_moan2002.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/methods/chin2010.hpp"
+#include "nystrom/methods/compositions.hpp"
+#include "nystrom/methods/dormand_prince1987.hpp"
+#include "nystrom/methods/gurkan.hpp"
+#include "nystrom/methods/method.hpp"
+
+namespace nystrom {
+
+namespace detail {
+
+inline bool any_complex(const std::vector<bigcomplex>& v) {
+  return std::any_of(v.begin(), v.end(), [](const bigcomplex& x) { return !x.is_real(); });
+}
+
+/// Fills the fields of MethodInfo that follow from the coefficients.
+NYSTROM_DECL void finalize_info(MethodDef& d) {
+  BigPrecision guard(128);
+  const MethodData data = d.build();
+  MethodInfo& in = d.info;
+  if (const auto* sp = std::get_if<SplittingScheme<bigcomplex>>(&data)) {
+    const auto s = normalized(*sp);
+    in.stages = 0;
+    for (const auto& st : s.steps) in.stages += st.flow == Flow::kick;
+    in.forces_per_step = s.forces_per_step();
+    in.fsal = s.fsal();
+    in.complex = std::any_of(s.steps.begin(), s.steps.end(), [](const auto& x) { return !x.coef.is_real(); });
+    if (in.complex) in.symplectic = false;  // imaginary parts are dropped after each step
+    if (in.complex && in.fsal) {  // ... so the last force, taken at a complex position, is not reusable
+      in.fsal = false;
+      ++in.forces_per_step;
+    }
+  } else if (const auto* t = std::get_if<RknTableau<bigcomplex>>(&data)) {
+    in.stages = static_cast<int>(t->stages());
+    in.forces_per_step = t->forces_per_step();
+    in.fsal = t->fsal();
+    in.complex = any_complex(t->c) || any_complex(t->b) || any_complex(t->B);
+    in.adaptive = in.adaptive || !t->bhat.empty();
+  } else if (const auto* m = std::get_if<MpeDef>(&data)) {
+    long sum = 0;
+    for (long k : m->k) sum += k;
+    in.stages = static_cast<int>(sum);
+    const bool kick_first = m->base.steps.front().flow == Flow::kick;
+    in.forces_per_step = static_cast<int>(sum) * m->base.forces_per_step() + (kick_first ? 1 : 0);
+    in.fsal = false;
+    in.complex = false;
+  }
+}
+
+inline std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace detail
+
+/// All named methods, with derived fields filled in. Built once.
+NYSTROM_DECL const std::vector<MethodDef>& catalog() {
+  static const std::vector<MethodDef> all = [] {
+    std::vector<MethodDef> v;
+    auto add = [&v](std::vector<MethodDef> more) {
+      for (auto& d : more) v.push_back(std::move(d));
+    };
+    add(methods::chin2010());
+    add(methods::chin2010_mpe());
+    add(methods::compositions());
+    add(methods::blanes_moan2002());
+    add(methods::gurkan());
+    add(methods::dormand_prince1987());
+    for (auto& d : v) detail::finalize_info(d);
+    return v;
+  }();
+  return all;
+}
+
+/// Resolves a method specification (see the top of this file). Throws std::invalid_argument.
+NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
+  if (spec.empty()) throw std::invalid_argument("empty method name");
+  for (const auto& d : catalog()) {
+    if (d.info.name == spec) return d;
+  }
+  const std::string ls = detail::lower(spec);
+  for (const auto& d : catalog()) {
+    if (detail::lower(d.info.name) == ls) return d;
+    for (const auto& a : d.info.aliases)
+      if (detail::lower(a) == ls) return d;
+  }
+  auto finalize = [](MethodDef d) {
+    detail::finalize_info(d);
+    return d;
+  };
+  // Adaptive multi-product methods (engines/adaptive_mpe.hpp): M<2n>-adaptive, mpe-adaptive:K, mpe-vv-adaptive:K.
+  auto adaptive_mpe = [&finalize](const std::vector<long>& k, const std::string& base, const std::string& name) {
+    if (k.size() < 2)
+      throw std::invalid_argument("an adaptive MPE needs at least two products (the error estimate drops one): '" + name + "'");
+    MethodDef d = methods::mpe_method(k, base, name);
+    d.info.adaptive = true;
+    d.info.description += ", adaptive step (embedded estimate: the products without the largest k)";
+    return finalize(d);
+  };
+  if (ls.rfind("mpe-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(13)), "PV", spec);
+  if (ls.rfind("mpe-pv-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(16)), "PV", spec);
+  if (ls.rfind("mpe-vv-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(16)), "VV", spec);
+  if (ls.size() > 10 && ls[0] == 'm' && ls.substr(ls.size() - 9) == "-adaptive" &&
+      std::all_of(ls.begin() + 1, ls.end() - 9, ::isdigit)) {
+    const long order = std::stol(ls.substr(1, ls.size() - 10));
+    if (order < 4 || order % 2 != 0 || order > 400)
+      throw std::invalid_argument("adaptive MPE order must be an even number between 4 and 400, got '" + spec + "'");
+    std::vector<long> k;
+    for (long i = 1; i <= order / 2; ++i) k.push_back(i);
+    return adaptive_mpe(k, "PV", "M" + std::to_string(order) + "-adaptive");
+  }
+  if (ls.rfind("mpe:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(4)), "PV", spec));
+  if (ls.rfind("mpe-pv:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(7)), "PV", spec));
+  if (ls.rfind("mpe-vv:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(7)), "VV", spec));
+  if (ls.size() >= 2 && ls[0] == 'm' && std::all_of(ls.begin() + 1, ls.end(), ::isdigit)) {
+    const long order = std::stol(ls.substr(1));
+    if (order < 2 || order % 2 != 0 || order > 400)
+      throw std::invalid_argument("MPE order must be an even number between 2 and 400, got '" + spec + "'");
+    std::vector<long> k;
+    for (long i = 1; i <= order / 2; ++i) k.push_back(i);
+    return finalize(methods::mpe_method(k, "PV", "M" + std::to_string(order)));
+  }
+  for (const auto& [prefix, base] : {std::pair<std::string, std::string>{"triplejump:", "PV"},
+                                     {"triplejump-pv:", "PV"},
+                                     {"triplejump-vv:", "VV"}})
+    if (ls.rfind(prefix, 0) == 0)
+      return finalize(methods::triple_jump_method(methods::parse_composition_order(spec.substr(prefix.size()), spec),
+                                                  base, ls));
+  for (const auto& [prefix, base] : {std::pair<std::string, std::string>{"suzuki:", "PV"},
+                                     {"suzuki-pv:", "PV"},
+                                     {"suzuki-vv:", "VV"}})
+    if (ls.rfind(prefix, 0) == 0)
+      return finalize(
+          methods::suzuki_method(methods::parse_composition_order(spec.substr(prefix.size()), spec), base, ls));
+  if (ls.rfind("file:", 0) == 0) return finalize(analysis::method_def_from_file(spec.substr(5)));  // analysis/method_file.hpp
+  if (ls.rfind("adjoint:", 0) == 0) {
+    MethodDef base = resolve_method(spec.substr(8));
+    auto build = base.build;
+    if (!std::holds_alternative<SplittingScheme<bigcomplex>>(build()))
+      throw std::invalid_argument("adjoint: is defined here for splitting methods only, not '" + base.info.name + "'");
+    MethodDef d = base;
+    d.info.name = "adjoint:" + base.info.name;
+    d.info.aliases.clear();
+    d.info.description = "adjoint of " + base.info.name;
+    d.build = [build] { return MethodData{adjoint(std::get<SplittingScheme<bigcomplex>>(build()))}; };
+    return finalize(d);
+  }
+  throw std::invalid_argument("unknown method '" + spec + "' (see `nystrom methods`)");
+}
+
+}  // namespace nystrom
