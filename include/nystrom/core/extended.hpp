@@ -94,6 +94,117 @@ void split_integer(I v, double& hi, double& lo) {
 
 }  // namespace detail
 
+// Inlining of libqd's double-double arithmetic. libqd declares its operations inline, but GCC leaves
+// its exact product qd::two_prod (Dekker's splitting, about 20 instructions without FMA) and the
+// products built on it out of line in the engines' loops, and every call spills the caller's live
+// registers: calls of operator* and two_prod took a fifth to a quarter of an M8 step in dd. For dd_real
+// the operations are forced inline; the products are libqd's own code (qd/inline.h, qd/dd_inline.h)
+// repeated here with a forced-inline two_prod, operation for operation, so the results are bitwise
+// libqd's. Quad-double's operations, several times larger, are left to the compiler as before.
+#if defined(__GNUC__) || defined(__clang__)
+#define NYSTROM_QD_FORCE_INLINE __attribute__((always_inline))
+#define NYSTROM_QD_NOINLINE __attribute__((noinline))
+#else
+#define NYSTROM_QD_FORCE_INLINE
+#define NYSTROM_QD_NOINLINE
+#endif
+
+namespace detail {
+
+/// libqd's qd::two_prod (with its qd::split), forced inline: a b = p + err exactly.
+NYSTROM_QD_FORCE_INLINE inline double dd_two_prod(double a, double b, double& err) {
+#ifdef QD_FMS
+  const double p = a * b;
+  err = QD_FMS(a, b, p);
+  return p;
+#else
+  auto split = [](double x, double& hi, double& lo) NYSTROM_QD_FORCE_INLINE {
+    double temp;
+    if (x > _QD_SPLIT_THRESH || x < -_QD_SPLIT_THRESH) {
+      x *= 3.7252902984619140625e-09;  // 2^-28
+      temp = _QD_SPLITTER * x;
+      hi = temp - (temp - x);
+      lo = x - hi;
+      hi *= 268435456.0;  // 2^28
+      lo *= 268435456.0;
+    } else {
+      temp = _QD_SPLITTER * x;
+      hi = temp - (temp - x);
+      lo = x - hi;
+    }
+  };
+  double a_hi, a_lo, b_hi, b_lo;
+  const double p = a * b;
+  split(a, a_hi, a_lo);
+  split(b, b_hi, b_lo);
+  err = ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo;
+  return p;
+#endif
+}
+
+#define NYSTROM_QD_ADD_SUB(ATTR)                                       \
+  ATTR static B add(const B& a, const B& b) { return a + b; }          \
+  ATTR static B add(const B& a, double b) { return a + b; }            \
+  ATTR static B add(double a, const B& b) { return a + b; }            \
+  ATTR static B sub(const B& a, const B& b) { return a - b; }          \
+  ATTR static B sub(const B& a, double b) { return a - b; }            \
+  ATTR static B sub(double a, const B& b) { return a - b; }            \
+  ATTR static B neg(const B& a) { return -a; }                         \
+  ATTR static void add_to(B& a, const B& b) { a += b; }                \
+  ATTR static void add_to(B& a, double b) { a += b; }                  \
+  ATTR static void sub_from(B& a, const B& b) { a -= b; }              \
+  ATTR static void sub_from(B& a, double b) { a -= b; }
+
+/// libqd's addition, subtraction and multiplication of B (see above).
+template <class Base>
+struct qd_arith {
+  using B = Base;
+  NYSTROM_QD_ADD_SUB()
+  static B mul(const B& a, const B& b) { return a * b; }
+  static B mul(const B& a, double b) { return a * b; }
+  static B mul(double a, const B& b) { return a * b; }
+  static void mul_by(B& a, const B& b) { a *= b; }
+  static void mul_by(B& a, double b) { a *= b; }
+};
+
+template <>
+struct qd_arith<::dd_real> {
+  using B = ::dd_real;
+  NYSTROM_QD_ADD_SUB(NYSTROM_QD_FORCE_INLINE)
+  // dd_inline.h's operator*(dd_real, dd_real), operator*(dd_real, double), operator*=, with dd_two_prod
+  NYSTROM_QD_FORCE_INLINE static B mul(const B& a, const B& b) {
+    double p1, p2;
+    p1 = dd_two_prod(a.x[0], b.x[0], p2);
+    p2 += (a.x[0] * b.x[1] + a.x[1] * b.x[0]);
+    p1 = qd::quick_two_sum(p1, p2, p2);
+    return B(p1, p2);
+  }
+  NYSTROM_QD_FORCE_INLINE static B mul(const B& a, double b) {
+    double p1, p2;
+    p1 = dd_two_prod(a.x[0], b, p2);
+    p2 += (a.x[1] * b);
+    p1 = qd::quick_two_sum(p1, p2, p2);
+    return B(p1, p2);
+  }
+  NYSTROM_QD_FORCE_INLINE static B mul(double a, const B& b) { return mul(b, a); }
+  NYSTROM_QD_FORCE_INLINE static void mul_by(B& x, const B& a) {
+    double p1, p2;
+    p1 = dd_two_prod(x.x[0], a.x[0], p2);
+    p2 += a.x[1] * x.x[0];
+    p2 += a.x[0] * x.x[1];
+    x.x[0] = qd::quick_two_sum(p1, p2, x.x[1]);
+  }
+  NYSTROM_QD_FORCE_INLINE static void mul_by(B& x, double a) {
+    double p1, p2;
+    p1 = dd_two_prod(x.x[0], a, p2);
+    p2 += x.x[1] * a;
+    x.x[0] = qd::quick_two_sum(p1, p2, x.x[1]);
+  }
+};
+#undef NYSTROM_QD_ADD_SUB
+
+}  // namespace detail
+
 /// A libqd number (B = dd_real or qd_real) that behaves as a complete scalar type in generic code:
 /// constructors from every integer type and from long double (exact; libqd accepts only int and
 /// double, so T(long) would be ambiguous), explicit conversions to float, double and long double,
@@ -126,25 +237,30 @@ struct qd_number : B {
   }
   explicit operator float() const { return static_cast<float>(this->x[0]); }
 
-  qd_number operator-() const { return -base(); }
-  qd_number& operator+=(const qd_number& o) { B::operator+=(o.base()); return *this; }
-  qd_number& operator-=(const qd_number& o) { B::operator-=(o.base()); return *this; }
-  qd_number& operator*=(const qd_number& o) { B::operator*=(o.base()); return *this; }
+  using arith = detail::qd_arith<B>;
+  NYSTROM_QD_FORCE_INLINE qd_number operator-() const { return arith::neg(base()); }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator+=(const qd_number& o) { arith::add_to(*this, o.base()); return *this; }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator-=(const qd_number& o) { arith::sub_from(*this, o.base()); return *this; }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator*=(const qd_number& o) { arith::mul_by(*this, o.base()); return *this; }
   qd_number& operator/=(const qd_number& o) { B::operator/=(o.base()); return *this; }
-  qd_number& operator+=(double o) { B::operator+=(o); return *this; }
-  qd_number& operator-=(double o) { B::operator-=(o); return *this; }
-  qd_number& operator*=(double o) { B::operator*=(o); return *this; }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator+=(double o) { arith::add_to(*this, o); return *this; }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator-=(double o) { arith::sub_from(*this, o); return *this; }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator*=(double o) { arith::mul_by(*this, o); return *this; }
   qd_number& operator/=(double o) { B::operator/=(o); return *this; }
 
-#define NYSTROM_QD_BINARY(op)                                                                                        \
-  friend qd_number operator op(const qd_number& a, const qd_number& b) { return a.base() op b.base(); }               \
-  friend qd_number operator op(const qd_number& a, double b) { return a.base() op b; }                                \
-  friend qd_number operator op(double a, const qd_number& b) { return a op b.base(); }
-  NYSTROM_QD_BINARY(+)
-  NYSTROM_QD_BINARY(-)
-  NYSTROM_QD_BINARY(*)
-  NYSTROM_QD_BINARY(/)
+#define NYSTROM_QD_BINARY(op, f)                                                                                    \
+  [[gnu::always_inline]] friend qd_number operator op(const qd_number& a, const qd_number& b) {                     \
+    return arith::f(a.base(), b.base());                                                                           \
+  }                                                                                                                \
+  [[gnu::always_inline]] friend qd_number operator op(const qd_number& a, double b) { return arith::f(a.base(), b); } \
+  [[gnu::always_inline]] friend qd_number operator op(double a, const qd_number& b) { return arith::f(a, b.base()); }
+  NYSTROM_QD_BINARY(+, add)
+  NYSTROM_QD_BINARY(-, sub)
+  NYSTROM_QD_BINARY(*, mul)
 #undef NYSTROM_QD_BINARY
+  friend qd_number operator/(const qd_number& a, const qd_number& b) { return a.base() / b.base(); }
+  friend qd_number operator/(const qd_number& a, double b) { return a.base() / b; }
+  friend qd_number operator/(double a, const qd_number& b) { return a / b.base(); }
 
 #define NYSTROM_QD_UNARY(f) \
   friend qd_number f(const qd_number& a) { return ::f(a.base()); }
@@ -182,6 +298,81 @@ struct qd_number : B {
 using double_double = qd_number<::dd_real>;
 /// libqd's quad-double (about 212 bits).
 using quad_double = qd_number<::qd_real>;
+
+// ---- r2^(-3/2) for inverse-square forces (scalar.hpp's inv_r3) -------------------------------
+//
+// libqd's sqrt is compiled in libqd (not inlined) and its division costs two double divisions and a
+// product; the Kepler force needs neither. From a double seed y = 1/sqrt(r2) (error about 2^-52),
+// e = 1 - r2 y^2 is formed to about 2^-106 (y^2 and the leading product exact, 1 - s exact by Sterbenz)
+// and
+//     r2^(-3/2) = y^3 (1 - e)^(-3/2) = y^3 (1 + 3/2 e + 15/8 e^2 + O(e^3)),   |e| < 2^-50,
+// with y^3 exact to about 2^-106 (two exact products): one correction takes the seed's 53 bits to
+// double-double accuracy. Quad-double takes the double-double value of r2^(-1/2) as its seed and
+// applies the same correction in quad-double (|e| about 2^-104). tests/test_precision.cpp checks
+// both against MPFR. Outside 2^-600 <= r2 <= 2^600 (and for 0, negative, infinite or NaN r2) they
+// fall back to the generic formula, where the seed's powers could leave the range of double.
+
+namespace detail {
+
+inline bool inv_r3_in_range(double a) { return a >= 0x1p-600 && a <= 0x1p600; }
+
+/// The generic formula, out of line (the rare case).
+template <class T>
+NYSTROM_QD_NOINLINE T inv_r3_generic(const T& r2) {
+  return T(1) / (r2 * sqrt(r2));
+}
+
+/// The seed y = 1/sqrt(a) of r2 = a + b (a in range), y^2 = p + p_lo exactly, and e + e_lo = 1 - r2 y^2
+/// to about 2^-106 (a p = s + s_lo exactly, 1 - s exact; b p_lo, below 2^-106, dropped).
+struct InvSqrtSeed {
+  double y, p, p_lo, e, e_lo;
+};
+NYSTROM_QD_FORCE_INLINE inline InvSqrtSeed inv_sqrt_seed(double a, double b) {
+  InvSqrtSeed r;
+  r.y = 1.0 / std::sqrt(a);
+  r.p = dd_two_prod(r.y, r.y, r.p_lo);
+  double s_lo;
+  const double s = dd_two_prod(a, r.p, s_lo);
+  r.e = qd::two_diff(1.0 - s, s_lo + (a * r.p_lo + b * r.p), r.e_lo);
+  return r;
+}
+
+}  // namespace detail
+
+/// r2^(-3/2) in double-double without division or square root of double-doubles (see above).
+NYSTROM_QD_FORCE_INLINE inline double_double inv_r3(const double_double& r2) {
+  const double a = r2.x[0], b = r2.x[1];
+  if (!detail::inv_r3_in_range(a)) [[unlikely]] return detail::inv_r3_generic(r2);
+  const auto [y, p, p_lo, e, e_lo] = detail::inv_sqrt_seed(a, b);
+  double z_lo, w_lo, h1_lo, h2_lo, lo_out;
+  const double z = detail::dd_two_prod(p, y, z_lo);  // y^3 = z + t to about 2^-106
+  const double t = z_lo + p_lo * y;
+  // (z + t)(1 + 3/2 (e + e_lo) + 15/8 e^2): z + w + w/2 exactly with w = z e (exact), the rest in lo
+  const double w = detail::dd_two_prod(z, e, w_lo);
+  const double h1 = qd::two_sum(z, w, h1_lo);
+  const double h2 = qd::two_sum(h1, 0.5 * w, h2_lo);
+  const double lo = (h1_lo + h2_lo) + (t + (1.5 * (w_lo + z * e_lo) + (1.5 * t + 1.875 * w) * e));
+  const double hi_out = qd::quick_two_sum(h2, lo, lo_out);
+  return double_double(hi_out, lo_out);
+}
+
+/// r2^(-3/2) in quad-double: the double-double r2^(-1/2) as seed, one correction in quad-double.
+inline quad_double inv_r3(const quad_double& r2) {
+  const double a = r2.x[0];
+  if (!detail::inv_r3_in_range(a)) [[unlikely]] return detail::inv_r3_generic(r2);
+  // y = r2^(-1/2) (1 + e0/2 + 3/8 e0^2) as a double-double, to about 2^-104
+  const auto [y0, p, p_lo, e0, e0_lo] = detail::inv_sqrt_seed(a, r2.x[1]);
+  double y_lo;
+  const double y_hi = qd::quick_two_sum(y0, y0 * (e0 * (0.5 + 0.375 * e0)), y_lo);
+  const ::qd_real y(y_hi, y_lo, 0.0, 0.0);
+  const ::qd_real y2 = sqr(y);
+  const ::qd_real d = 1.0 - r2.base() * y2;   // e = 1 - r2 y^2, |e| about 2^-104
+  const ::dd_real e(d.x[0], d.x[1]);          // to about 2^-210 absolute
+  const ::dd_real c = e * (1.5 + 1.875 * e);  // (1 - e)^(-3/2) - 1 (e^3 below 2^-300)
+  // (libqd 2.3's qd_real * dd_real misses the product a[3] b_hi: quad-double products only)
+  const ::qd_real z = y2 * y;                 // y^3
+  return z + z * ::qd_real(c.x[0], c.x[1], 0.0, 0.0);
+}
 
 // ---- run-time MPFR precision ------------------------------------------------------------------
 

@@ -6,6 +6,7 @@
 //   * is_complex_v<S>
 //   * scalar_traits<T>     name, mantissa bits, conversion from an MPFR reference value
 //   * real_part(x)         projection used by complex-coefficient methods
+//   * inv_r3(r2)           r2^(-3/2), the r^-3 of inverse-square forces (overloaded for dd and qd)
 // double and long double are defined here; extended types (float128, dd_real, qd_real,
 // mpfr_float) add their specialisations in nystrom/core/precision.hpp.
 #pragma once
@@ -75,6 +76,16 @@ S real_part(const S& x) {
 template <class T>
 std::complex<T> real_part(const std::complex<T>& x) {
   return std::complex<T>(x.real(), T(0));
+}
+
+/// r2^(-3/2): the 1/r^3 of an inverse-square force from r2 = |q|^2 (Kepler). The generic version is
+/// exactly S(1) / (r2 * sqrt(r2)), so double and the other hardware and MPFR types keep their
+/// arithmetic bit for bit. Double-double and quad-double overload it (core/extended.hpp) without
+/// libqd's square root (out of line) and division: a double seed and one correction.
+template <class S>
+S inv_r3(const S& r2) {
+  using std::sqrt;
+  return S(1) / (r2 * sqrt(r2));
 }
 
 /// |x| for real or complex scalars, as a real.

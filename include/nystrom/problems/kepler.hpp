@@ -17,13 +17,20 @@
 namespace nystrom {
 
 /// Force functor: works for any real or complex scalar (complex square root for complex q).
+/// Real scalars form 1/r^3 by inv_r3 (core/scalar.hpp: S(1) / (r2 sqrt(r2)), so -inv_r3 is bitwise
+/// S(-1) / (r2 r) in every correctly rounded type; double-double and quad-double have their own).
 struct KeplerForce {
   template <class S>
   void operator()(const std::array<S, 2>& q, std::array<S, 2>& a) const {
-    using std::sqrt;
     const S r2 = q[0] * q[0] + q[1] * q[1];
-    const S r = sqrt(r2);
-    const S minv = S(-1) / (r2 * r);
+    const S minv = [&] {
+      if constexpr (is_complex_v<S>) {
+        using std::sqrt;
+        return S(-1) / (r2 * sqrt(r2));
+      } else {
+        return S(-inv_r3(r2));
+      }
+    }();
     a[0] = minv * q[0];
     a[1] = minv * q[1];
   }
