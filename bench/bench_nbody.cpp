@@ -135,6 +135,8 @@ BENCHMARK(BM_force<NBodyKernel::generic, false>)
     ->Apply(config)
     ->Args({400, 1})
     ->Args({10000, 1});
+// The generic kernel on complex positions (std::complex<double>, the portable path) at the small N only.
+BENCHMARK(BM_force<NBodyKernel::generic, true>)->Name("generic_complex")->Apply(config)->Args({400, 1});
 BENCHMARK(BM_force<NBodyKernel::simd, true>)
     ->Name("simd_complex")
     ->Apply(config)
