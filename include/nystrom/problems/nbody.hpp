@@ -529,7 +529,9 @@ class NBodyForce {
     params_ = o.params_;
     kernel = o.kernel;
     threads = o.threads;
+#if NYSTROM_HAVE_AVX512_KERNEL
     scratch_.reset();
+#endif
     return *this;
   }
   NBodyForce(NBodyForce&&) noexcept = default;
@@ -557,7 +559,6 @@ class NBodyForce {
 
   template <class V>
   void operator()(const V& q, V& a) const {
-    using S = typename V::value_type;
     const std::size_t n = size();
     if (n == 0) throw std::invalid_argument("N-body force used without a particle set");
     if (q.size() != 3 * n)
@@ -566,6 +567,7 @@ class NBodyForce {
     resize_like(a, q);
     const int nt = threads > 0 ? threads : nbody_max_threads();
 #if NYSTROM_HAVE_AVX512_KERNEL
+    using S = typename V::value_type;
     if constexpr (std::is_same_v<S, double> || std::is_same_v<S, std::complex<double>>) {
       if (uses_simd<S>()) {
         simd_force(q, a, nt);
