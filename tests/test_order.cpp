@@ -52,6 +52,7 @@
 #include <string>
 #include <vector>
 
+#include "nystrom/methods/refine.hpp"
 #include "nystrom/nystrom.hpp"
 
 using namespace nystrom;
