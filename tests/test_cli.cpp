@@ -124,6 +124,20 @@ TEST(Cli, AdaptiveMethodMeetsItsTolerance) {
   EXPECT_EQ(j["force_evals"].get<long>() % 17, 2);  // 17 per attempted step + 2 for the starting step
 }
 
+TEST(Cli, AdaptiveMultiProductRunsFromTheCommandLine) {
+  // M10-adaptive (engines/adaptive_mpe.hpp) through `run`: error follows the tolerance, and the
+  // velocity-Verlet form runs too (a multi-product method is not an RKN tableau with an embedded pair).
+  const auto loose = run("run --method M10-adaptive --tol 1e-8 --ecc 0.9 --periods 2 --json");
+  const auto tight = run("run --method mpe-vv-adaptive:1,2,3,4,5 --tol 1e-11 --ecc 0.9 --periods 2 --json");
+  ASSERT_EQ(loose.code, 0) << loose.err;
+  ASSERT_EQ(tight.code, 0) << tight.err;
+  const auto jl = nlohmann::json::parse(loose.out), jt = nlohmann::json::parse(tight.out);
+  EXPECT_LT(jt["position_error"].get<double>(), 1e-7);
+  EXPECT_LT(jt["position_error"].get<double>(), jl["position_error"].get<double>());
+  EXPECT_GT(jt["steps"].get<long>(), jl["steps"].get<long>());
+  EXPECT_GT(jl["steps"].get<long>(), 10);
+}
+
 TEST(Cli, NBodyTwoBodyAndGbsRuns) {
   // Two equal masses at e = 0.2 with Gurkan's BR1: fifth order, so 4x the steps cut the error ~1000x.
   auto err = [&](int n) {

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "nystrom/engines/adaptive_mpe.hpp"
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/engines/integrator.hpp"
@@ -49,8 +50,9 @@ void kepler_diagnostics(KeplerRunResult& r, const KeplerProblem<T>& prob, const 
 
 }  // namespace detail
 
-/// Integrates `periods` orbits with an adaptive method (embedded pair) at tolerance `tol`, in real type T.
-/// `steps` in the result counts accepted steps.
+/// Integrates `periods` orbits with an adaptive method at tolerance `tol`, in real type T: an RKN
+/// tableau with an embedded pair (DP12-adaptive) or a multi-product method (M10-adaptive,
+/// mpe-adaptive:K; engines/adaptive_mpe.hpp). `steps` in the result counts accepted steps.
 template <class T>
 KeplerRunResult run_kepler_adaptive(const MethodDef& def, double ecc, double tol, long periods) {
   if (periods <= 0) throw std::invalid_argument("number of periods must be positive");
@@ -58,12 +60,18 @@ KeplerRunResult run_kepler_adaptive(const MethodDef& def, double ecc, double tol
   const KeplerProblem<T> prob(static_cast<T>(ecc));
   AdaptiveOptions opt;
   opt.tol = tol;
-  auto integ = make_adaptive_integrator<std::array<T, 2>>(def, KeplerForce{}, opt);
   const auto s0 = prob.initial_state();
   auto s = s0;
   const T t_end = KeplerProblem<T>::period() * T(periods);
   const auto t0 = std::chrono::steady_clock::now();
-  const AdaptiveStats st = integ.integrate_to(s, T(0), t_end);
+  AdaptiveStats st;
+  if (std::holds_alternative<MpeDef>(def.build())) {
+    auto integ = make_adaptive_mpe_integrator<std::array<T, 2>>(def, KeplerForce{}, opt);
+    st = integ.integrate_to(s, T(0), t_end);
+  } else {
+    auto integ = make_adaptive_integrator<std::array<T, 2>>(def, KeplerForce{}, opt);
+    st = integ.integrate_to(s, T(0), t_end);
+  }
   const auto t1 = std::chrono::steady_clock::now();
   KeplerRunResult r;
   r.method = def.info.name;
