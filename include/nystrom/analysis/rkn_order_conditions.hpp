@@ -81,8 +81,13 @@ struct SnTree {
 namespace sn_detail {
 
 inline std::string derivative_name(std::size_t m) {
-  if (m <= 3) return "f" + std::string(m, '\'');
-  return "f^(" + std::to_string(m) + ")";
+  // Appends rather than "literal" + std::string: GCC 12 reports false -Warray-bounds in the latter.
+  std::string s = "f";
+  if (m <= 3) return s.append(m, '\'');
+  s += "^(";
+  s += std::to_string(m);
+  s += ')';
+  return s;
 }
 
 /// Appends all fat trees of order n to `trees` (all trees of lower order must be present).
@@ -104,10 +109,16 @@ inline void grow(std::vector<SnTree>& trees, std::vector<std::size_t>& first, in
           const SnTree& u = trees[static_cast<std::size_t>(k)];
           g *= static_cast<std::uint64_t>(u.order + 1) * u.gamma;
         }
-        args += (args.empty() ? "" : ",") + (k < 0 ? std::string("v") : trees[static_cast<std::size_t>(k)].name);
+        if (!args.empty()) args += ',';
+        args += k < 0 ? std::string("v") : trees[static_cast<std::size_t>(k)].name;
       }
       t.gamma = g;
-      t.name = derivative_name(cur.size()) + (cur.empty() ? "" : "(" + args + ")");
+      t.name = derivative_name(cur.size());
+      if (!cur.empty()) {
+        t.name += '(';
+        t.name += args;
+        t.name += ')';
+      }
       made.push_back(std::move(t));
       return;
     }
