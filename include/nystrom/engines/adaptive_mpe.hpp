@@ -91,44 +91,6 @@ inline AdaptiveMpeCoefficients adaptive_mpe_coefficients(const std::vector<long>
   return r;
 }
 
-namespace adaptive_detail {
-
-/// Hairer's starting step (HNW I, II.4) for y' = F(y), y = (q, v), F = (v, a(q)): two force
-/// evaluations; norms in double (they only set the order of magnitude).
-template <class V, class F, class R>
-R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const R& tol, int order) {
-  using std::abs;
-  const std::size_t n = s.q.size();
-  V a0 = s.q, a1 = s.q;
-  force(s.q, a0);
-  auto norm = [&](auto&& comp) {
-    double sum = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const R sq = tol * (R(1) + abs(s.q[i]));
-      const R sv = tol * (R(1) + abs(s.v[i]));
-      const auto [x, y] = comp(i);
-      const double rx = as_double(R(x / sq)), ry = as_double(R(y / sv));
-      sum += rx * rx + ry * ry;
-    }
-    return std::sqrt(sum / static_cast<double>(2 * n));
-  };
-  const double d0 = norm([&](std::size_t i) { return std::pair<R, R>(s.q[i], s.v[i]); });
-  const double d1 = norm([&](std::size_t i) { return std::pair<R, R>(s.v[i], a0[i]); });
-  double h0d = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
-  h0d = std::min(h0d, as_double(hmax));
-  const R h0(h0d);
-  V q1 = s.q;
-  for (std::size_t i = 0; i < n; ++i) q1[i] = s.q[i] + h0 * s.v[i];
-  force(q1, a1);
-  const double d2 = norm([&](std::size_t i) { return std::pair<R, R>(h0 * a0[i], a1[i] - a0[i]); }) / h0d;
-  const double dm = std::max(d1, d2);
-  const double h1 = dm <= 1e-15 ? std::max(1e-6, h0d * 1e-3) : std::pow(0.01 / dm, 1.0 / (order + 1));
-  double h = std::min(100 * h0d, h1);
-  if (!std::isfinite(h) || !(h > 0)) h = as_double(hmax) * 1e-3;
-  return std::min(R(h), hmax);
-}
-
-}  // namespace adaptive_detail
 
 template <class V, class Force>
 class AdaptiveMpeIntegrator {
