@@ -91,7 +91,6 @@ inline AdaptiveMpeCoefficients adaptive_mpe_coefficients(const std::vector<long>
   return r;
 }
 
-
 template <class V, class Force>
 class AdaptiveMpeIntegrator {
   static std::string sci(double x) { return adaptive_detail::sci(x); }
