@@ -175,3 +175,30 @@ TEST(AdaptiveRkn, StepLimitIsAClearError) {
   auto s = KeplerProblem<LD>(0.5L).initial_state();
   EXPECT_THROW(ai.integrate_to(s, 0.0L, 100.0L), TooManySteps);
 }
+
+// The step ratio (shared by both adaptive engines): standard = safety * err^(-1/(p+1)); predictive
+// (Gustafsson) also follows the trend of the last two accepted steps, and only ever shrinks.
+TEST(AdaptiveRkn, StepControllerRatios) {
+  AdaptiveOptions o;
+  o.safety = 0.5;
+  o.fac_min = 0.2;
+  o.fac_max = 4.0;
+  for (bool predictive : {false, true}) {
+    o.predictive = predictive;
+    adaptive_detail::StepController c(o);
+    EXPECT_DOUBLE_EQ(c.accepted(2.0, 1.0, false), 1.0);  // the first step: no trend yet
+    // The error grew (q fell from 2 to 1.6) and the step fell from 1 to 0.8: predictive shrinks by
+    // (0.8 / 1) * (1.6 / 2) = 0.64 more.
+    const double f = c.accepted(1.6, 0.8, false);
+    EXPECT_DOUBLE_EQ(f, predictive ? 0.5 * 1.6 * 0.64 : 0.5 * 1.6);
+    // The error fell: the trend factor would grow the step; the standard ratio is kept.
+    EXPECT_DOUBLE_EQ(c.accepted(3.2, 0.8, false), 1.6);
+    EXPECT_DOUBLE_EQ(c.accepted(100.0, 1.0, false), 4.0);  // clamped to fac_max
+    EXPECT_DOUBLE_EQ(c.accepted(100.0, 1.0, true), 1.0);   // no growth right after a rejection
+    EXPECT_DOUBLE_EQ(c.accepted(INFINITY, 1.0, false), 4.0);  // err = 0
+    EXPECT_DOUBLE_EQ(c.rejected(0.5), 0.25);
+    EXPECT_DOUBLE_EQ(c.rejected(0.01), 0.2);  // clamped to fac_min
+    EXPECT_DOUBLE_EQ(c.rejected(0.0), 0.2);   // err = inf
+    EXPECT_DOUBLE_EQ(c.rejected(NAN), 0.2);   // err NaN
+  }
+}

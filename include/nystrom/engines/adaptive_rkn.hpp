@@ -27,7 +27,9 @@
 //   * norm: err = sqrt( (1/2n) sum_i (e_i / sc_i)^2 ) over all n positions and n velocities, with
 //     sc_i = tol * (1 + max(|y_i(t)|, |y_i(t+h)|)): mixed absolute/relative with one tolerance;
 //   * accept when err <= 1; new h = h * min(fac_max, max(fac_min, safety * err^(-1/(p+1)))), p the
-//     lower order of the pair; after a rejection the step may not grow in the next attempt;
+//     lower order of the pair, or Gustafsson's predictive ratio when smaller (opt.predictive, on by
+//     default; adaptive_detail::StepController); after a rejection the step may not grow in the next
+//     attempt;
 //   * first step: Hairer's starting-step algorithm (two force evaluations) unless opt.h0 > 0; later
 //     calls continue with the step proposed at the end of the previous call;
 //   * the last step is shortened to land exactly on t1 (and a step within 1% of the end is stretched).
@@ -76,6 +78,7 @@ struct AdaptiveOptions {
   double h_max = 0.0;      // largest step; 0: |t1 - t0|
   long max_steps = 10000000;  // accepted + rejected steps per integrate_to call
   int error_order = 0;     // p, the lower order of the pair; 0: determined from the tableau
+  bool predictive = true;  // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
 
   void validate() const {
     if (!std::isfinite(tol) || !(tol > 0)) throw std::invalid_argument("tolerance must be a positive finite number");
@@ -161,6 +164,42 @@ R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const R& tol, 
   if (!std::isfinite(h) || !(h > 0)) h = as_double(hmax) * 1e-3;
   return std::min(R(h), hmax);
 }
+/// The step ratio of both adaptive engines. q = err^(-1/(p+1)) of the attempted step (+inf for
+/// err = 0, NaN for an error that is not finite), h its size. After an accepted step: safety * q, or
+/// with opt.predictive (Gustafsson, ACM TOMS 20 (1994) 496; HNW II, IV.8, as in RADAU5) the smaller of
+/// that and safety * q * (h_n / h_{n-1}) * (q_n / q_{n-1}) = safety * q * (h_n / h_{n-1}) *
+/// (err_{n-1} / err_n)^(1/(p+1)), which follows the trend of the last two accepted steps: a step that
+/// must shrink step after step (Kepler e = 0.9 falling towards pericentre) is shrunk ahead instead of
+/// rejected. Then clamped to [fac_min, fac_max], and at most 1 right after a rejection. After a
+/// rejected step: safety * q clamped to [fac_min, 1] (fac_min for an error that is not finite).
+class StepController {
+ public:
+  explicit StepController(const AdaptiveOptions& opt) : opt_(opt) {}
+
+  double accepted(double q, double h, bool after_rejection) {
+    double fac = opt_.fac_max;
+    if (std::isfinite(q)) {
+      fac = opt_.safety * q;
+      if (opt_.predictive && q_prev_ > 0) fac = std::min(fac, fac * (h / h_prev_) * (q / q_prev_));
+      q_prev_ = q;
+    } else {
+      q_prev_ = 0;
+    }
+    h_prev_ = h;
+    fac = std::min(opt_.fac_max, std::max(opt_.fac_min, fac));
+    return after_rejection ? std::min(fac, 1.0) : fac;
+  }
+
+  double rejected(double q) const {
+    if (!(q >= 0) || !std::isfinite(q)) return opt_.fac_min;
+    return std::min(1.0, std::max(opt_.fac_min, opt_.safety * q));
+  }
+
+ private:
+  const AdaptiveOptions& opt_;
+  double q_prev_ = 0, h_prev_ = 0;  // of the last accepted step
+};
+
 }  // namespace adaptive_detail
 
 template <class V, class Force>
@@ -225,6 +264,7 @@ class AdaptiveRknIntegrator {
     real_type t = t0;
     real_type h_want = h;  // the controller's proposal for the next step
     bool last_rejected = false;
+    adaptive_detail::StepController ctl(opt_);
     State<V> y = s, err;
     while (t < t1) {
       if (st.accepted + st.rejected >= opt_.max_steps)
@@ -248,18 +288,14 @@ class AdaptiveRknIntegrator {
         ++st.accepted;
         st.last_h = as_double(h);
         obs(static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
-        double fac = e > 0 ? opt_.safety * std::pow(e, expo) : opt_.fac_max;
-        fac = std::min(opt_.fac_max, std::max(opt_.fac_min, fac));
-        if (last_rejected) fac = std::min(fac, 1.0);
+        const double fac = ctl.accepted(std::pow(e, expo), as_double(h), last_rejected);
         // After a step shortened to land on t1, keep the earlier proposal for the next call.
         h_next_ = last && h < h_want ? h_want : std::min(h * real_type(fac), hmax);
         h_want = std::min(h * real_type(fac), hmax);
         last_rejected = false;
       } else {
         ++st.rejected;
-        double fac = std::isfinite(e) ? opt_.safety * std::pow(e, expo) : opt_.fac_min;
-        fac = std::min(1.0, std::max(opt_.fac_min, fac));
-        h_want = h * real_type(fac);
+        h_want = h * real_type(ctl.rejected(std::pow(e, expo)));
         last_rejected = true;
       }
     }
