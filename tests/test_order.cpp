@@ -36,7 +36,8 @@
 // disappears with the imaginary parts (Gürkan, abstract and Fig 5.1: AC1 is formally 5th order but
 // shows 6th). Only for complex methods is declared <= observed <= declared + 1 (each +-0.35)
 // accepted; real methods must match their declared order.
-// Adaptive methods are tested separately (step-size control) and are skipped here.
+// Adaptive methods are skipped by the order test; ToleranceProportionality (end of this file) runs each
+// adaptive catalog entry and adaptive multi-product specifications at two tolerances instead.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -336,3 +337,44 @@ TEST(ObservedOrderControl, MeasurementIsGenericInTheScalarType) {
   const auto m = measure_order<double>(find_in_catalog("VV"), 2);
   EXPECT_TRUE(order_matches(2, m.observed, false)) << m.log();
 }
+
+// ---- adaptive methods: the error follows the tolerance ------------------------------------------------
+
+namespace {
+
+/// Every adaptive catalog entry, and adaptive multi-product specifications (resolved, not listed).
+std::vector<std::string> adaptive_names() {
+  std::vector<std::string> names;
+  for (const auto& d : catalog())
+    if (d.info.adaptive) names.push_back(d.info.name);
+  for (const char* spec : {"M6-adaptive", "M10-adaptive", "M14-adaptive", "mpe-vv-adaptive:1,2,3,4"})
+    names.push_back(spec);
+  return names;
+}
+
+class ToleranceProportionality : public testing::TestWithParam<std::string> {};
+
+}  // namespace
+
+// The order test skips adaptive methods; here each one integrates Kepler e = 0.5 over one period in
+// double at tol 1e-6 and 1e-9 (the controller's defaults). A method whose error did not follow the
+// tolerance (an estimate of the wrong order, a broken controller) fails: the error must stay within 100
+// tol, fall by 30-30000x for the 1000x tighter tolerance (proportional up to the usual tol^(p/(p+1))
+// and error-growth factors), and cost more forces.
+TEST_P(ToleranceProportionality, ErrorFollowsTheTolerance) {
+  const MethodDef def = resolve_method(GetParam());
+  ASSERT_TRUE(def.info.adaptive) << GetParam();
+  const auto loose = run_kepler_adaptive<double>(def, 0.5, 1e-6, 1);
+  const auto tight = run_kepler_adaptive<double>(def, 0.5, 1e-9, 1);
+  std::cout << "[ tol      ] " << std::left << std::setw(24) << GetParam() << " error " << std::scientific
+            << std::setprecision(2) << loose.position_error << " -> " << tight.position_error << "  forces "
+            << loose.force_evals << " -> " << tight.force_evals << std::endl;
+  EXPECT_LT(loose.position_error, 100 * 1e-6);
+  EXPECT_LT(tight.position_error, 100 * 1e-9);
+  const double ratio = loose.position_error / tight.position_error;
+  EXPECT_GT(ratio, 30.0);
+  EXPECT_LT(ratio, 3e4);
+  EXPECT_GT(tight.force_evals, loose.force_evals);
+}
+
+INSTANTIATE_TEST_SUITE_P(Adaptive, ToleranceProportionality, testing::ValuesIn(adaptive_names()), test_name);
