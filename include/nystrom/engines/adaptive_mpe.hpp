@@ -27,7 +27,7 @@
 // usual beta it drives the error far below the tolerance, a mere rescaling of tol; not kept.) The
 // predictive ratio matters on Kepler e = 0.9: with the standard one, M14-adaptive rejected 500-700
 // steps per 3000 accepted (the optimal step falls by ~30% per step towards pericentre, faster than
-// the controller follows); predictive, 0-100, and the same final error costs 25-35% less time.)
+// the controller follows); predictive, 0-100, and the same final error costs 25-35% less time.
 //
 // Cost per step: sum k_i force evaluations (+1 for a base that starts with a kick: the force at q_0,
 // shared by all products and kept across a rejected step). The products of a step run in lockstep so
@@ -251,9 +251,10 @@ class AdaptiveMpeIntegrator {
     using SS = SplittingStepper<V, Force>;
     const std::size_t n = s.q.size();
     SS::for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
+      if (kick_first_) assign(a[r], a0);
+      if (merged_) return;  // increment form: advance_increments starts x from zero, no carries
       assign(x[r].q, s.q);
       assign(x[r].v, s.v);
-      if (kick_first_) assign(a[r], a0);
       if constexpr (Comp) {
         for (auto& e : cq[r]) e = scalar_type(0);
         for (auto& e : cv[r]) e = scalar_type(0);
