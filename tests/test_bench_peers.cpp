@@ -86,7 +86,7 @@ class BenchPeers : public ::testing::Test {
 const std::vector<std::string> kNystromFixed{"VV", "M4", "M6", "M6-5F", "A6", "M8", "KL8", "M10", "SS10", "M12", "DP12"};
 const std::vector<std::string> kOdeintFixed{"odeint velocity_verlet", "odeint sb3a_mclachlan", "odeint sb3a_m4_mclachlan",
                                             "odeint rkf78"};
-const std::vector<std::string> kAdaptive{"DP12-adaptive", "M10-adaptive", "M12-adaptive", "M14-adaptive", "M12-adaptive (no comp.)",
+const std::vector<std::string> kAdaptive{"DP12-adaptive", "M10-adaptive", "M12-adaptive", "M14-adaptive", "M16-adaptive", "M12-adaptive (no comp.)",
                                          "GBS",           "odeint dopri5", "odeint bulirsch_stoer"};
 
 }  // namespace

@@ -125,7 +125,7 @@ struct PeerConfig {
   std::vector<double> eccs{0.5, 0.9};
   long periods = 100;
   double spp_ratio = std::pow(2.0, 0.25);  // steps-per-period ratio of consecutive fixed-step runs
-  double tol_ratio = std::pow(10.0, 0.5);   // tolerance ratio of consecutive adaptive runs
+  double tol_ratio = std::pow(10.0, 0.25);  // tolerance ratio of consecutive adaptive runs (both libraries)
   double tol_max = 1e-3, tol_min = 1e-15;
   long force_cap = 30'000'000;  // per run
   double min_time = 0.2;        // repeat a run until this much time has been spent ...
@@ -402,7 +402,7 @@ inline std::vector<MethodSpec> peer_methods(double ecc, long periods) {
   for (const char* name : {"VV", "M4", "M6", "M6-5F", "A6", "M8", "KL8", "M10", "SS10", "M12", "DP12"})
     m.push_back(nystrom_fixed(name, ecc, periods));
   m.push_back(nystrom_adaptive("DP12-adaptive", ecc, periods));
-  for (const char* name : {"M10-adaptive", "M12-adaptive", "M14-adaptive"})
+  for (const char* name : {"M10-adaptive", "M12-adaptive", "M14-adaptive", "M16-adaptive"})
     m.push_back(nystrom_adaptive_mpe(name, ecc, periods));
   m.push_back(nystrom_adaptive_mpe("M12-adaptive", ecc, periods, false));
   m.push_back(nystrom_gbs(ecc, periods));
@@ -498,10 +498,12 @@ inline std::vector<PeerRun> sweep_method(const MethodSpec& m, double ecc, const 
     out.push_back(r);
     if (progress) progress();
   };
-  // Stop once the error has reached the floor, or has not improved on its best for three runs while
-  // already small (the round-off plateau).
+  // Stop once the error has reached the floor, or has not improved on its best for 1.5 decades of
+  // tolerance (adaptive; at least three runs) or three runs (fixed step) while already small (the
+  // round-off plateau; the errors of adaptive runs scatter by up to 10x between neighbouring tolerances).
   double best = std::numeric_limits<double>::infinity();
   int stale = 0;
+  const int stale_max = m.adaptive ? std::max(3, static_cast<int>(std::lround(1.5 / std::log10(cfg.tol_ratio)))) : 3;
   auto done = [&](double err) {
     if (err < best * 0.7) {
       best = err;
@@ -509,7 +511,7 @@ inline std::vector<PeerRun> sweep_method(const MethodSpec& m, double ecc, const 
     } else if (best < 1e-9) {
       ++stale;
     }
-    return err < cfg.floor_error || stale >= 3;
+    return err < cfg.floor_error || stale >= stale_max;
   };
   if (m.adaptive) {
     for (double tol = cfg.tol_max; tol >= cfg.tol_min * 0.999; tol /= cfg.tol_ratio) {
