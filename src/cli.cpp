@@ -164,7 +164,7 @@ void plot_xy(const std::string& png_path, const std::string& title, const std::s
     else if (s.style == "points") with = "points ps 1.3 pt " + pt;
     else if (s.style == "thick") with = "lines lw 6 lc rgb '#80808080'";
     else throw std::invalid_argument("unknown plot style '" + s.style + "'");
-    plots.push_back("$d" + std::to_string(idx) + " using 1:2 with " + with + " title " + quote_gnuplot(s.label));
+    plots.push_back("$d" + std::to_string(idx) + " using 1:2 with " + with + " title " + quote_gnuplot(s.label) + " noenhanced");  // names such as velocity_verlet: no subscripts
     ++idx;
   }
   if (plots.empty()) throw UsageError("nothing to plot: every value is zero, negative or not finite");
