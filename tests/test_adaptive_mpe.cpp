@@ -1,6 +1,7 @@
 // The adaptive multi-product expansion (engines/adaptive_mpe.hpp): the embedded estimate has the
 // order it claims, the error on Kepler follows the tolerance, the step shrinks at pericentre and steps
-// are rejected there at e = 0.9, force evaluations are counted exactly, the lockstep and sequential
+// are rejected there at e = 0.9, a high order at a tight tolerance does not aim below the
+// estimate's round-off, force evaluations are counted exactly, the lockstep and sequential
 // schedules give bitwise the same results, and bad input fails with std::invalid_argument.
 #include <gtest/gtest.h>
 
@@ -111,6 +112,25 @@ TEST(AdaptiveMpe, KeplerErrorTracksTheTolerance) {
   EXPECT_LT(errs[1], 1e-2 * errs[0]);
   EXPECT_GT(work[1], work[0]);
   EXPECT_LT(work[1], 4 * work[0]);  // about tol^(-1/9): 2.2x for 1000x
+}
+
+// At high order and tight tolerance the default controller must not aim below the round-off of the
+// estimate (sum |d_i| ~ 175 for M16 times the increments' rounding): M16-adaptive on Kepler e = 0.5,
+// one period, tol 1e-11 -> 1e-13 should cost about 100^(1/15) = 1.36x the forces. Measured: 1.22x with
+// the default safety 0.9; 3.7x with 0.7, which aims at err = 0.7^15 = 0.005 tol (and 37x for 1e-14).
+TEST(AdaptiveMpe, HighOrderTightToleranceStaysAboveTheEstimatesRoundOff) {
+  const double T = KeplerProblem<double>::period();
+  std::vector<long> work;
+  for (double tol : {1e-11, 1e-13}) {
+    long calls = 0;
+    auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("M16-adaptive"), CountingKepler{&calls}, with_tol(tol));
+    State<V2> s = KeplerProblem<double>(0.5).initial_state();
+    const AdaptiveStats st = ai.integrate_to(s, 0.0, T);
+    work.push_back(st.force_evals);
+    EXPECT_LT(position_error(s, 0.5, T), 100 * tol) << tol;
+  }
+  EXPECT_GT(work[1], work[0]);
+  EXPECT_LT(work[1], 2 * work[0]) << work[0] << " -> " << work[1];
 }
 
 // Kepler e = 0.9: the step at pericentre is far smaller than at apocentre, the end time is hit
