@@ -1,8 +1,9 @@
 // `nystrom bench-peers [--quick] [--out DIR] [--periods N] [--ecc 0.5,0.9] [--no-plot]`:
 // work-precision of nystrom's methods against Boost.Odeint's on the Kepler problem (final position error
 // after N periods against force evaluations and wall time), with, for each target error 1e-6, 1e-9 and
-// 1e-12, the fastest run of each library and the ratio odeint time / nystrom time; and the round-off
-// floor of M8, SS10 and DP12 with compensated summation on and off. See bench/peers/peers.hpp.
+// 1e-12, the fastest run of each library and the ratio odeint time / nystrom time (from the sweeps, then
+// from the two runs re-timed alternately); and the round-off floor of M8, SS10, DP12 and M12-adaptive
+// with compensated summation on and off. See bench/peers/peers.hpp.
 //
 // Files in DIR: peers_runs.csv (every run), peers.json (runs and summaries), and per eccentricity E
 // peers_forces_eE.png and peers_time_eE.png (gnuplot).
@@ -193,6 +194,44 @@ nystrom::cli::Registrar reg(
                                 {"ratio", std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr)},
                                 {"nystrom_ns_per_force", a && a->forces > 0 ? nlohmann::json(a->seconds * 1e9 / static_cast<double>(a->forces)) : nlohmann::json(nullptr)},
                                 {"odeint_ns_per_force", b && b->forces > 0 ? nlohmann::json(b->seconds * 1e9 / static_cast<double>(b->forces)) : nlohmann::json(nullptr)}});
+            }
+        }
+
+        // The pairs of the first table re-timed alternately (peers.hpp interleaved): the ratio of two
+        // runs measured at the same moments, not minutes apart.
+        {
+          const int pairs = o->quick ? 2 : 25;
+          fmt::print("\n## the same runs re-timed alternately ({} times each, fastest of each)\n{:>5} {:>7}  {:<26} {:>11} "
+                     "{:<28} {:>11} {:>8}\n",
+                     pairs, "e", "target", "nystrom", "seconds", "odeint", "seconds", "ratio");
+          auto spec = [&](const np::PeerRun& r) -> const np::MethodSpec* {
+            for (const auto& [e, m] : jobs)
+              if (e == r.ecc && m.label == r.label) return &m;
+            return nullptr;
+          };
+          j["targets_interleaved"] = nlohmann::json::array();
+          for (double e : eccs)
+            for (double target : kTargets) {
+              const np::PeerRun* a = np::cheapest(runs, "nystrom", e, target);
+              const np::PeerRun* b = np::cheapest(runs, "odeint", e, target);
+              if (!a || !b || !spec(*a) || !spec(*b)) continue;
+              const auto [oa, ob] = np::interleaved(*spec(*a), a->param, *spec(*b), b->param, e, pairs);
+              const bool ok = oa.ok && ob.ok;
+              const double ratio = ok ? ob.seconds / oa.seconds : std::numeric_limits<double>::quiet_NaN();
+              fmt::print("{:>5} {:>7.0e}  {:<26} {:>11.3g} {:<28} {:>11.3g} {:>8}\n", ecc_tag(e), target, a->label,
+                         oa.seconds, b->label, ob.seconds, ok ? fmt::format("{:.1f}x", ratio) : "failed");
+              j["targets_interleaved"].push_back({{"ecc", e},
+                                                  {"target", target},
+                                                  {"pairs", pairs},
+                                                  {"nystrom", a->label},
+                                                  {"nystrom_param", a->param},
+                                                  {"nystrom_seconds", oa.seconds},
+                                                  {"nystrom_error", ok ? nlohmann::json(oa.error) : nlohmann::json(nullptr)},
+                                                  {"odeint", b->label},
+                                                  {"odeint_param", b->param},
+                                                  {"odeint_seconds", ob.seconds},
+                                                  {"odeint_error", ok ? nlohmann::json(ob.error) : nlohmann::json(nullptr)},
+                                                  {"ratio", ok ? nlohmann::json(ratio) : nlohmann::json(nullptr)}});
             }
         }
 

@@ -248,6 +248,32 @@ TEST_F(BenchPeers, AnyConfigurationTableIncludesTheVariants) {
   }
 }
 
+// The re-timed pairs: one per target both libraries reached, the same runs as the first table, rebuilt
+// from their specifications: nystrom's runs are deterministic, so the error is the sweep's to the bit
+// (odeint's bulirsch_stoer is not: its force counts differ between repetitions); the ratio is odeint's
+// time over nystrom's.
+TEST_F(BenchPeers, InterleavedRetimingRebuildsTheSameRuns) {
+  const auto& ref = (*j_)["targets"];
+  const auto& il = (*j_)["targets_interleaved"];
+  std::size_t both = 0;
+  for (const auto& t : ref)
+    if (!t["nystrom"].is_null() && !t["odeint"].is_null()) {
+      ASSERT_LT(both, il.size());
+      const auto& p = il[both++];
+      EXPECT_EQ(p["ecc"], t["ecc"]);
+      EXPECT_EQ(p["target"], t["target"]);
+      EXPECT_EQ(p["nystrom"], t["nystrom"]["label"]);
+      EXPECT_EQ(p["odeint"], t["odeint"]["label"]);
+      ASSERT_FALSE(p["ratio"].is_null());
+      EXPECT_EQ(p["nystrom_error"].get<double>(), t["nystrom"]["error"].get<double>());
+      EXPECT_LE(p["odeint_error"].get<double>(), 10 * t["target"].get<double>());
+      EXPECT_GT(p["nystrom_seconds"].get<double>(), 0);
+      EXPECT_DOUBLE_EQ(p["ratio"].get<double>(), p["odeint_seconds"].get<double>() / p["nystrom_seconds"].get<double>());
+    }
+  EXPECT_EQ(il.size(), both);
+  EXPECT_GE(both, 3u);
+}
+
 // Compensated summation (the default for double) lowers the round-off floor (smallest error of the
 // sweep) at e = 0.5, where the quick sweeps reach it.
 // The fixed-step methods only: the adaptive MPE runs its products in increment form with compensation
