@@ -46,6 +46,22 @@ double position_error(const State<V2>& s, double ecc, double t) {
   return static_cast<double>(std::hypot(static_cast<long double>(s.q[0]) - ex.q[0], static_cast<long double>(s.q[1]) - ex.q[1]));
 }
 
+/// One period of Kepler e = 0.5 with the default controller at tolerance tol.
+struct OnePeriod {
+  double tol = 0, error = 0;
+  long force_evals = 0, calls = 0;
+};
+OnePeriod one_period(const char* spec, double tol) {
+  const double T = KeplerProblem<double>::period();
+  OnePeriod r;
+  r.tol = tol;
+  auto ai = make_adaptive_mpe_integrator<V2>(resolve_method(spec), CountingKepler{&r.calls}, with_tol(tol));
+  State<V2> s = KeplerProblem<double>(0.5).initial_state();
+  r.force_evals = ai.integrate_to(s, 0.0, T).force_evals;
+  r.error = position_error(s, 0.5, T);
+  return r;
+}
+
 }  // namespace
 
 // The exact coefficients: both combinations sum to 1, the error weights to 0, and the dropped product
@@ -96,22 +112,14 @@ TEST(AdaptiveMpe, EmbeddedEstimateHasItsOrder) {
 // Kepler e = 0.5 over one period: the error follows the tolerance (bounded by a fixed multiple of it,
 // and smaller at the tighter tolerance) and the work grows slowly.
 TEST(AdaptiveMpe, KeplerErrorTracksTheTolerance) {
-  const double T = KeplerProblem<double>::period();
-  std::vector<double> errs;
-  std::vector<long> work;
-  for (double tol : {1e-8, 1e-11}) {
-    long calls = 0;
-    auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("M10-adaptive"), CountingKepler{&calls}, with_tol(tol));
-    State<V2> s = KeplerProblem<double>(0.5).initial_state();
-    const AdaptiveStats st = ai.integrate_to(s, 0.0, T);
-    EXPECT_EQ(st.force_evals, calls);
-    errs.push_back(position_error(s, 0.5, T));
-    work.push_back(st.force_evals);
-    EXPECT_LT(errs.back(), 100 * tol) << tol;
+  const OnePeriod loose = one_period("M10-adaptive", 1e-8), tight = one_period("M10-adaptive", 1e-11);
+  for (const OnePeriod* r : {&loose, &tight}) {
+    EXPECT_EQ(r->force_evals, r->calls);
+    EXPECT_LT(r->error, 100 * r->tol) << r->tol;
   }
-  EXPECT_LT(errs[1], 1e-2 * errs[0]);
-  EXPECT_GT(work[1], work[0]);
-  EXPECT_LT(work[1], 4 * work[0]);  // about tol^(-1/9): 2.2x for 1000x
+  EXPECT_LT(tight.error, 1e-2 * loose.error);
+  EXPECT_GT(tight.force_evals, loose.force_evals);
+  EXPECT_LT(tight.force_evals, 4 * loose.force_evals);  // about tol^(-1/9): 2.2x for 1000x
 }
 
 // At high order and tight tolerance the default controller must not aim below the round-off of the
@@ -119,18 +127,10 @@ TEST(AdaptiveMpe, KeplerErrorTracksTheTolerance) {
 // one period, tol 1e-11 -> 1e-13 should cost about 100^(1/15) = 1.36x the forces. Measured: 1.22x with
 // the default safety 0.9; 3.7x with 0.7, which aims at err = 0.7^15 = 0.005 tol (and 37x for 1e-14).
 TEST(AdaptiveMpe, HighOrderTightToleranceStaysAboveTheEstimatesRoundOff) {
-  const double T = KeplerProblem<double>::period();
-  std::vector<long> work;
-  for (double tol : {1e-11, 1e-13}) {
-    long calls = 0;
-    auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("M16-adaptive"), CountingKepler{&calls}, with_tol(tol));
-    State<V2> s = KeplerProblem<double>(0.5).initial_state();
-    const AdaptiveStats st = ai.integrate_to(s, 0.0, T);
-    work.push_back(st.force_evals);
-    EXPECT_LT(position_error(s, 0.5, T), 100 * tol) << tol;
-  }
-  EXPECT_GT(work[1], work[0]);
-  EXPECT_LT(work[1], 2 * work[0]) << work[0] << " -> " << work[1];
+  const OnePeriod loose = one_period("M16-adaptive", 1e-11), tight = one_period("M16-adaptive", 1e-13);
+  for (const OnePeriod* r : {&loose, &tight}) EXPECT_LT(r->error, 100 * r->tol) << r->tol;
+  EXPECT_GT(tight.force_evals, loose.force_evals);
+  EXPECT_LT(tight.force_evals, 2 * loose.force_evals) << loose.force_evals << " -> " << tight.force_evals;
 }
 
 // Kepler e = 0.9: the step at pericentre is far smaller than at apocentre, the end time is hit
