@@ -214,8 +214,10 @@ nystrom::cli::Registrar reg(
             for (double target : kTargets) {
               const np::PeerRun* a = np::cheapest(runs, "nystrom", e, target);
               const np::PeerRun* b = np::cheapest(runs, "odeint", e, target);
-              if (!a || !b || !spec(*a) || !spec(*b)) continue;
-              const auto [oa, ob] = np::interleaved(*spec(*a), a->param, *spec(*b), b->param, e, pairs);
+              const np::MethodSpec* sa = a ? spec(*a) : nullptr;
+              const np::MethodSpec* sb = b ? spec(*b) : nullptr;
+              if (!sa || !sb) continue;
+              const auto [oa, ob] = np::interleaved(*sa, a->param, *sb, b->param, e, pairs);
               const bool ok = oa.ok && ob.ok;
               const double ratio = ok ? ob.seconds / oa.seconds : std::numeric_limits<double>::quiet_NaN();
               fmt::print("{:>5} {:>7.0e}  {:<26} {:>11.3g} {:<28} {:>11.3g} {:>8}\n", ecc_tag(e), target, a->label,
