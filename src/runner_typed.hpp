@@ -25,21 +25,10 @@ RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
   const long n = req.steps_per_period * req.periods;
   const T h = HarmonicProblem<T>::period() / T(req.steps_per_period);
   auto s = prob.initial_state();
-  long evals = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  EngineOptions opt{req.keep_complex};
-  if (def.info.complex) {
-    using C = std::complex<T>;
-    auto integ = make_integrator<std::array<C, 1>>(def, HarmonicForce{}, opt);
-    auto sc = convert_state<std::array<C, 1>>(s);
-    integ.integrate(sc, h, n);
-    s = convert_state<std::array<T, 1>>(sc);
-    evals = integ.force_evals();
-  } else {
-    auto integ = make_integrator<std::array<T, 1>>(def, HarmonicForce{}, opt);
-    integ.integrate(s, h, n);
-    evals = integ.force_evals();
-  }
+  RealStateIntegrator<std::array<T, 1>, HarmonicForce> integ(def, HarmonicForce{}, EngineOptions{req.keep_complex});
+  integ.integrate(s, h, n);
+  const long evals = integ.force_evals();
   const auto t1 = std::chrono::steady_clock::now();
   RunReport r;
   r.steps = n;

@@ -162,6 +162,14 @@ struct Compensator {
     valid = true;
   }
   void invalidate() { valid = false; }
+  /// Carries restored from a checkpoint taken at state s: the next begin(s) continues with them.
+  void restore(const V& q_carry, const V& v_carry, const State<V>& s) {
+    resize_like(cq, q_carry);
+    resize_like(cv, v_carry);
+    assign(cq, q_carry);
+    assign(cv, v_carry);
+    end(s);
+  }
   /// q += d (compensated).
   void add_q(V& q, const V& d) {
     for (std::size_t i = 0; i < q.size(); ++i) compensated_add(q[i], cq[i], d[i]);

@@ -191,7 +191,13 @@ class AdaptiveMpeIntegrator {
   void reset() {
     h_next_ = real_type(0);
     comp_.invalidate();
+    resume_.valid = false;
   }
+  /// Where the last run stopped at its observer's request (AdaptiveResumePoint, adaptive_rkn.hpp).
+  const AdaptiveResumePoint<real_type>& resume_point() const { return resume_; }
+  void set_resume_point(const AdaptiveResumePoint<real_type>& p) { resume_ = p; }
+  /// The compensated-summation carries of the run (checkpoint/restart).
+  Compensator<V>& compensator() { return comp_; }
 
  private:
   // The unrolled loops are compiled for std::array states of float and double only (as in MpeStepper).
@@ -530,11 +536,20 @@ class AdaptiveMpeIntegrator {
     if (t1 == t0) return st;
 
     const real_type span = t1 - t0;
-    const real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
+    real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
     const real_type tol(opt_.tol);
     const real_type eps = epsilon_of<real_type>();
     real_type h;
-    if (opt_.h0 > 0) {
+    adaptive_detail::StepController ctl(opt_);
+    bool last_rejected = false;
+    const bool resume = resume_.valid && resume_.t == t0;
+    resume_.valid = false;
+    if (resume) {
+      h = resume_.h_want;
+      hmax = resume_.hmax;
+      last_rejected = resume_.last_rejected;
+      ctl.restore(resume_.q_prev, resume_.h_prev);
+    } else if (opt_.h0 > 0) {
       h = real_type(opt_.h0);
     } else if (h_next_ > real_type(0)) {
       h = h_next_;
@@ -555,8 +570,7 @@ class AdaptiveMpeIntegrator {
     const real_type tiny = real_type(16) * eps * std::max(abs(t0), abs(t1));
     real_type t = t0;
     real_type h_want = h;
-    bool last_rejected = false;
-    adaptive_detail::StepController ctl(opt_);
+    bool error_finite = true;  // the last error estimate was finite (else the force returned NaN or inf)
 
     constexpr bool local = K > 0;
     std::conditional_t<local, State<V>, State<V>&> s = s_io;
@@ -593,7 +607,8 @@ class AdaptiveMpeIntegrator {
     while (t < t1) {
       if (accepted + rejected >= opt_.max_steps) {
         store();
-        throw TooManySteps("adaptive MPE: more than " + std::to_string(opt_.max_steps) + " steps before reaching t1");
+        throw TooManySteps("adaptive MPE: more than " + std::to_string(opt_.max_steps) + " steps before reaching t1 = " +
+                           sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
       }
       h = h_want;
       bool last = false;
@@ -609,8 +624,9 @@ class AdaptiveMpeIntegrator {
       if (!(h > tiny) || !(h > real_type(0))) {
         store();
         throw StepSizeUnderflow("adaptive MPE: step size underflow at t = " + sci(as_double(t)) +
-                                " (h = " + sci(as_double(h)) +
-                                "): the tolerance cannot be met or the solution is singular");
+                                " (h = " + sci(as_double(h)) + "): " +
+                                (error_finite ? "the tolerance cannot be met or the solution is singular"
+                                              : "the force returned NaN or infinity in this step"));
       }
       if (!(local && verlet)) scale(h);
       if (kick_first_ && !a0_valid) {
@@ -626,6 +642,7 @@ class AdaptiveMpeIntegrator {
       } else
         trial<Comp>(k_.size(), s, a0, xs_, as_, cqs_, cvs_, inc, err);
       const double e2 = error_norm2(s, inc, err, tol);
+      error_finite = e2 < std::numeric_limits<double>::infinity();
       if (e2 <= 1.0) {
         for (std::size_t j = 0; j < s.q.size(); ++j) {
           if constexpr (Comp) {
@@ -640,12 +657,16 @@ class AdaptiveMpeIntegrator {
         t = last ? t1 : t + h;
         ++accepted;
         last_h = as_double(h);
-        obs(static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
+        const bool stop = adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
         const double fac = ctl.accepted(std::pow(e2, expo), as_double(h), last_rejected);
         const real_type hn = std::min(h * real_type(fac), hmax);
         h_next_ = last && h < h_want ? h_want : hn;  // a step shortened to land on t1 keeps the proposal
         h_want = hn;
         last_rejected = false;
+        if (stop && t < t1) {
+          resume_ = {t, h_want, hmax, false, ctl.q_prev(), ctl.h_prev(), true};
+          break;
+        }
       } else {
         ++rejected;
         h_want = h * real_type(ctl.rejected(std::pow(e2, expo)));
@@ -670,6 +691,7 @@ class AdaptiveMpeIntegrator {
   bool merged_ = false;   // the base's steps merge (every symmetric base): the increment form applies
   V qbuf_{};
   real_type h_next_ = real_type(0);
+  AdaptiveResumePoint<real_type> resume_;
   AdaptiveStats total_;
   Compensator<V> comp_;
   V a0_{};

@@ -56,26 +56,19 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 
 #include "nystrom/analysis/rkn_order_conditions.hpp"
 #include "nystrom/core/bignum.hpp"
+#include "nystrom/core/error.hpp"
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/methods/method.hpp"
 #include "nystrom/methods/method_data.hpp"
 
 namespace nystrom {
-
-class StepSizeUnderflow : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-class TooManySteps : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct AdaptiveOptions {
   double tol = 1e-10;      // absolute and relative tolerance (see the norm above)
@@ -203,12 +196,45 @@ class StepController {
     return std::min(1.0, std::max(opt_.fac_min, opt_.safety * q));
   }
 
+  /// The history of the last accepted step (checkpoint/restart).
+  double q_prev() const { return q_prev_; }
+  double h_prev() const { return h_prev_; }
+  void restore(double q_prev, double h_prev) {
+    q_prev_ = q_prev;
+    h_prev_ = h_prev;
+  }
+
  private:
   const AdaptiveOptions& opt_;
   double q_prev_ = 0, h_prev_ = 0;  // of the last accepted step
 };
 
+/// Calls the observer; true when it asks the run to stop (an observer that returns bool).
+template <class Observer, class R, class St>
+bool observe(Observer& obs, const R& t, const St& s) {
+  if constexpr (std::is_same_v<std::invoke_result_t<Observer&, const R&, const St&>, bool>) {
+    return obs(t, s);
+  } else {
+    obs(t, s);
+    return false;
+  }
+}
+
 }  // namespace adaptive_detail
+
+/// Where an adaptive run stopped between two accepted steps, with all that its controller needs to
+/// go on exactly as if it had not stopped: the next step size, the step bound, whether the last
+/// attempt was rejected and the predictive controller's history. An observer that returns true stops
+/// integrate_to after the step it has seen; the engine keeps this point (resume_point()), and the
+/// next integrate_to from that time continues from it (also after set_resume_point on a new engine,
+/// for a restart from a checkpoint): the steps are bitwise those of the uninterrupted run.
+template <class R>
+struct AdaptiveResumePoint {
+  R t{}, h_want{}, hmax{};
+  bool last_rejected = false;
+  double q_prev = 0, h_prev = 0;
+  bool valid = false;
+};
 
 template <class V, class Force>
 class AdaptiveRknIntegrator {
@@ -252,12 +278,21 @@ class AdaptiveRknIntegrator {
     if (t1 == t0) return st;
 
     const real_type span = t1 - t0;
-    const real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
+    real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
     const real_type tol(opt_.tol);
     const real_type eps = epsilon_of<real_type>();
     real_type h;
     long extra_evals = 0;
-    if (opt_.h0 > 0) {
+    adaptive_detail::StepController ctl(opt_);
+    bool last_rejected = false;
+    const bool resume = resume_.valid && resume_.t == t0;
+    resume_.valid = false;
+    if (resume) {
+      h = resume_.h_want;
+      hmax = resume_.hmax;
+      last_rejected = resume_.last_rejected;
+      ctl.restore(resume_.q_prev, resume_.h_prev);
+    } else if (opt_.h0 > 0) {
       h = real_type(opt_.h0);
     } else if (h_next_ > real_type(0)) {
       h = h_next_;
@@ -271,12 +306,12 @@ class AdaptiveRknIntegrator {
     const real_type tiny = real_type(16) * eps * std::max(abs(t0), abs(t1));
     real_type t = t0;
     real_type h_want = h;  // the controller's proposal for the next step
-    bool last_rejected = false;
-    adaptive_detail::StepController ctl(opt_);
+    bool error_finite = true;  // the last error estimate was finite (else the force returned NaN or inf)
     State<V> y = s, err;
     while (t < t1) {
       if (st.accepted + st.rejected >= opt_.max_steps)
-        throw TooManySteps("adaptive RKN: more than " + std::to_string(opt_.max_steps) + " steps before reaching t1");
+        throw TooManySteps("adaptive RKN: more than " + std::to_string(opt_.max_steps) + " steps before reaching t1 = " +
+                           sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
       h = h_want;
       bool last = false;
       if (t + h * real_type(1.01) >= t1) {
@@ -285,22 +320,28 @@ class AdaptiveRknIntegrator {
       }
       if (!(h > tiny) || !(h > real_type(0)))
         throw StepSizeUnderflow("adaptive RKN: step size underflow at t = " + sci(as_double(t)) +
-                                " (h = " + sci(as_double(h)) +
-                                "): the tolerance cannot be met or the solution is singular");
+                                " (h = " + sci(as_double(h)) + "): " +
+                                (error_finite ? "the tolerance cannot be met or the solution is singular"
+                                              : "the force returned NaN or infinity in this step"));
       assign_state(y, s);
       stepper_.step_with_error(y, h, err);
       const double e = error_norm(s, y, err, tol);  // the controller works in double: 2 digits suffice
+      error_finite = e < std::numeric_limits<double>::infinity();
       if (e <= 1.0) {
         assign_state(s, y);
         t = last ? t1 : t + h;
         ++st.accepted;
         st.last_h = as_double(h);
-        obs(static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
+        const bool stop = adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
         const double fac = ctl.accepted(std::pow(e, expo), as_double(h), last_rejected);
         // After a step shortened to land on t1, keep the earlier proposal for the next call.
         h_next_ = last && h < h_want ? h_want : std::min(h * real_type(fac), hmax);
         h_want = std::min(h * real_type(fac), hmax);
         last_rejected = false;
+        if (stop && t < t1) {
+          resume_ = {t, h_want, hmax, false, ctl.q_prev(), ctl.h_prev(), true};
+          break;
+        }
       } else {
         ++st.rejected;
         h_want = h * real_type(ctl.rejected(std::pow(e, expo)));
@@ -313,7 +354,13 @@ class AdaptiveRknIntegrator {
   }
 
   /// Forget the step carried over between calls (the next call estimates a first step again).
-  void reset() { h_next_ = real_type(0); }
+  void reset() {
+    h_next_ = real_type(0);
+    resume_.valid = false;
+  }
+  /// Where the last run stopped at its observer's request (valid == false: it did not stop).
+  const AdaptiveResumePoint<real_type>& resume_point() const { return resume_; }
+  void set_resume_point(const AdaptiveResumePoint<real_type>& p) { resume_ = p; }
 
  private:
   static RknTableau<scalar_type> check(RknTableau<scalar_type> t) {
@@ -354,6 +401,7 @@ class AdaptiveRknIntegrator {
   RknStepper<V, Force> stepper_;
   int method_order_ = 0;
   real_type h_next_ = real_type(0);
+  AdaptiveResumePoint<real_type> resume_;
   AdaptiveStats total_;
 };
 

@@ -28,9 +28,11 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "nystrom/core/error.hpp"
 #include "nystrom/core/state.hpp"
 
 namespace nystrom {
@@ -82,6 +84,10 @@ struct GbsOptions {
 
 template <class V, class F>
 class GbsIntegrator {
+  struct NoObserver {
+    void operator()(const real_t<typename V::value_type>&, const State<V>&) const {}
+  };
+
  public:
   using scalar_type = typename V::value_type;
   using real_type = real_t<scalar_type>;
@@ -124,23 +130,51 @@ class GbsIntegrator {
   F& force() { return force_; }
   const std::vector<long>& sequence() const { return nseq_; }
 
-  /// Advances s by exactly `span` (> 0) with adaptive steps.
-  void integrate_to(State<V>& s, real_type span) {
+  /// Where a run stopped at its observer's request, with the controller's state: integrate_to with the
+  /// same span continues from it exactly as if it had not stopped (also on a new integrator after
+  /// set_resume_point: a restart from a checkpoint).
+  struct ResumePoint {
+    real_type t{}, span{}, H{};
+    int k = 0;
+    bool last_rejected = false;
+    bool valid = false;
+  };
+  const ResumePoint& resume_point() const { return resume_; }
+  void set_resume_point(const ResumePoint& p) { resume_ = p; }
+  /// The counters (a restart from a checkpoint continues them).
+  void set_counters(long force_evals, long accepted, long rejected) {
+    evals_ = force_evals;
+    accepted_ = accepted;
+    rejected_ = rejected;
+  }
+
+  /// Advances s by exactly `span` (> 0) with adaptive steps. obs(t, s) is called after every accepted
+  /// step with t the time since the start of the span; if it returns true, the run stops there and keeps
+  /// its resume point.
+  template <class Obs = NoObserver>
+  void integrate_to(State<V>& s, real_type span, Obs&& obs = {}) {
     using std::abs;
     if (!(span > real_type(0)) || !is_finite_scalar(span)) throw std::invalid_argument("GBS: the time span must be positive");
     real_type t(0);
     if (!(H_ > real_type(0))) H_ = span;
     long tries = 0;
     bool last_rejected = false;
+    if (resume_.valid && resume_.span == span) {
+      t = resume_.t;
+      H_ = resume_.H;
+      k_ = resume_.k;
+      last_rejected = resume_.last_rejected;
+    }
+    resume_.valid = false;
     while (t < span) {
       if (++tries > opt_.max_steps)
-        throw std::invalid_argument("GBS: more than " + std::to_string(opt_.max_steps) + " steps for one span (t = " +
+        throw too_many_steps("GBS: more than " + std::to_string(opt_.max_steps) + " steps for one span (t = " +
                                     detail::fmt_g(as_double(t)) + " of " + detail::fmt_g(as_double(span)) + ")");
       const real_type rem = span - t;
       const bool final_step = H_ >= rem * real_type(0.999999);  // avoid a sliver of a last step
       const real_type H = final_step ? rem : H_;
       if (!(H > abs(span) * real_type(1e-3) * epsilon_of<real_type>()) && !final_step)
-        throw std::invalid_argument("GBS: step size underflow at t = " + detail::fmt_g(as_double(t)) +
+        throw step_size_underflow("GBS: step size underflow at t = " + detail::fmt_g(as_double(t)) +
                                     " (singular force, or a tolerance the precision cannot reach)");
       real_type Hnew;
       if (try_step(s, H, last_rejected, Hnew)) {
@@ -150,13 +184,22 @@ class GbsIntegrator {
         // keep the controller's step unless this was a shortened final step that is smaller than it
         if (!final_step || Hnew < H_ || H >= H_) H_ = Hnew;
         else H_ = std::max(H_, Hnew);
+        bool stop = false;
+        if constexpr (std::is_same_v<std::invoke_result_t<Obs&, const real_type&, const State<V>&>, bool>)
+          stop = obs(static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
+        else
+          obs(static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
+        if (stop && t < span) {
+          resume_ = {t, span, H_, k_, false, true};
+          return;
+        }
       } else {
         ++rejected_;
         last_rejected = true;
         H_ = Hnew;
       }
       if (!is_finite_scalar(H_) || !(H_ > real_type(0)))
-        throw std::invalid_argument("GBS: the step size became invalid (the solution is not finite)");
+        throw step_size_underflow("GBS: the step size became invalid (the solution is not finite)");
     }
   }
 
@@ -164,6 +207,8 @@ class GbsIntegrator {
   void integrate(State<V>& s, real_type h, long n) {
     for (long i = 0; i < n; ++i) integrate_to(s, h);
   }
+  /// The controller's order (columns) and step, for a restart.
+  int columns() const { return k_; }
   void step(State<V>& s, real_type h) { integrate_to(s, h); }
 
  private:
@@ -317,6 +362,7 @@ class GbsIntegrator {
   std::vector<State<V>> row_, prev_;
   V f0_{}, f_{}, delta_{};
   long evals_ = 0, accepted_ = 0, rejected_ = 0;
+  ResumePoint resume_;
 };
 
 }  // namespace nystrom

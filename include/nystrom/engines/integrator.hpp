@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -11,6 +12,7 @@
 #include <variant>
 
 #include "nystrom/core/bignum.hpp"
+#include "nystrom/core/error.hpp"
 #include "nystrom/engines/mpe.hpp"
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/engines/splitting.hpp"
@@ -60,6 +62,10 @@ class Integrator {
   F& force() {
     return std::visit([](auto& e) -> F& { return e.force(); }, impl_);
   }
+  /// The compensated-summation carries of the run (checkpoint/restart).
+  Compensator<V>& compensator() {
+    return std::visit([](auto& e) -> Compensator<V>& { return e.compensator(); }, impl_);
+  }
 
  private:
   using Impl = std::variant<SplittingStepper<V, F>, RknStepper<V, F>, MpeStepper<V, F>>;
@@ -83,13 +89,52 @@ class Integrator {
 /// Builds `def` for state type V at a reference precision matched to V's scalar type. Coefficients
 /// published as decimals with too few digits for that type are refined (methods/refine.hpp), or
 /// refused with std::invalid_argument when they cannot be.
+/// An adaptive method (info.adaptive: "DP12-adaptive", "M12-adaptive", ...) is refused with
+/// invalid_input: its step size comes from a tolerance, which solve() (nystrom/solve.hpp) handles.
 template <class V, class F>
 Integrator<V, F> make_integrator(const MethodDef& def, F force, EngineOptions opt = {}) {
   using T = real_t<typename V::value_type>;
+  if (def.info.adaptive)
+    throw invalid_input("method '" + def.info.name +
+                        "' chooses its steps from a tolerance: run it with solve() (nystrom/solve.hpp), not with "
+                        "fixed steps");
   const MethodData data = method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
   // The working values are created outside method_data_for's reference precision: for
   // run-time-precision types (mpfr_real) it must not leak into the working precision.
   return Integrator<V, F>(data, std::move(force), opt);
 }
+
+/// Any fixed-step method on a real state: a real method steps it directly; a complex-coefficient method
+/// steps its complexified copy (rebind_vector_t<V, std::complex<T>>) and the real parts come back after
+/// every call (the imaginary parts are dropped after every step inside the engine unless
+/// EngineOptions::keep_complex). The one place where a real state meets a complex method.
+template <class V, class F>
+class RealStateIntegrator {
+ public:
+  using real_type = typename V::value_type;
+  using VC = rebind_vector_t<V, std::complex<real_type>>;
+
+  RealStateIntegrator(const MethodDef& def, F force, EngineOptions opt = {})
+      : impl_(def.info.complex ? Impl(std::in_place_index<1>, make_integrator<VC>(def, std::move(force), opt))
+                               : Impl(std::in_place_index<0>, make_integrator<V>(def, std::move(force), opt))) {}
+
+  /// n steps of size h, in place.
+  void integrate(State<V>& s, real_type h, long n) {
+    if (auto* r = std::get_if<0>(&impl_)) {
+      r->integrate(s, h, n);
+    } else {
+      auto sc = convert_state<VC>(s);
+      std::get<1>(impl_).integrate(sc, h, n);
+      s = convert_state<V>(sc);
+    }
+  }
+  long force_evals() const {
+    return std::visit([](const auto& e) { return e.force_evals(); }, impl_);
+  }
+
+ private:
+  using Impl = std::variant<Integrator<V, F>, Integrator<VC, F>>;
+  Impl impl_;
+};
 
 }  // namespace nystrom

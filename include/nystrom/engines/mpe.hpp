@@ -158,7 +158,9 @@ class MpeStepper {
     }
     if (concurrent_) {
       // One copy of the base (and of its force functor) per product; the longest products first.
-      workers_.assign(k_.size(), base_);
+      // Copy-constructed, not assigned: a capturing lambda (a force a user writes) is not assignable.
+      workers_.reserve(k_.size());
+      for (std::size_t i = 0; i < k_.size(); ++i) workers_.push_back(base_);
       order_.resize(k_.size());
       std::iota(order_.begin(), order_.end(), std::size_t{0});
       std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return k_[a] > k_[b]; });
@@ -174,6 +176,8 @@ class MpeStepper {
     return e;
   }
   Force& force() { return base_.force(); }
+  /// The compensated-summation carries of the run (checkpoint/restart).
+  Compensator<V>& compensator() { return comp_; }
   const std::vector<long>& sequence() const { return k_; }
 
   void step(State<V>& s, real_type h) { integrate(s, h, 1); }

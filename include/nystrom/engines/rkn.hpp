@@ -96,6 +96,8 @@ class RknStepper {
   const RknTableau<scalar_type>& tableau() const { return t_; }
   long force_evals() const { return evals_; }
   Force& force() { return force_; }
+  /// The compensated-summation carries of the run (checkpoint/restart).
+  Compensator<V>& compensator() { return comp_; }
   void reset_cache() { cache_valid_ = false; }
 
   void step(State<V>& s, real_type h) { integrate(s, h, 1); }

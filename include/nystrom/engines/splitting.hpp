@@ -103,6 +103,8 @@ class SplittingStepper {
   const SplittingScheme<scalar_type>& scheme() const { return scheme_; }
   long force_evals() const { return evals_; }
   Force& force() { return force_; }
+  /// The compensated-summation carries of the run (checkpoint/restart).
+  Compensator<V>& compensator() { return comp_; }
 
   /// Forget the cached force (the next kick evaluates).
   void reset_cache() { cache_valid_ = false; }

@@ -126,22 +126,11 @@ KeplerRunResult run_kepler(const MethodDef& def, double ecc, long steps_per_peri
   const long n = steps_per_period * periods;
   const T h = KeplerProblem<T>::period() / T(steps_per_period);
   const auto s0 = prob.initial_state();
-  State<std::array<T, 2>> s;
-  long evals = 0;
+  State<std::array<T, 2>> s = s0;
   const auto t0 = std::chrono::steady_clock::now();
-  if (def.info.complex) {
-    using C = std::complex<T>;
-    auto integ = make_integrator<std::array<C, 2>>(def, KeplerForce{}, opt);
-    auto sc = convert_state<std::array<C, 2>>(s0);
-    integ.integrate(sc, h, n);
-    s = convert_state<std::array<T, 2>>(sc);
-    evals = integ.force_evals();
-  } else {
-    auto integ = make_integrator<std::array<T, 2>>(def, KeplerForce{}, opt);
-    s = s0;
-    integ.integrate(s, h, n);
-    evals = integ.force_evals();
-  }
+  RealStateIntegrator<std::array<T, 2>, KeplerForce> integ(def, KeplerForce{}, opt);
+  integ.integrate(s, h, n);
+  const long evals = integ.force_evals();
   const auto t1 = std::chrono::steady_clock::now();
   KeplerRunResult r;
   r.method = def.info.name;

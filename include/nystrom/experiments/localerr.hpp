@@ -86,37 +86,20 @@ inline NBodyInstance make_nbody_instance(const NBodySetup& s) {
   return r;
 }
 
-/// One method, real or complex, stepping real states (complex methods convert in and out).
+/// One method, real or complex, stepping real states (RealStateIntegrator converts for complex methods).
 class NBodyMethodStepper {
  public:
   using V = std::vector<double>;
-  using VC = std::vector<std::complex<double>>;
-  NBodyMethodStepper(const MethodDef& def, const NBodyForce<double>& f) : info_(def.info) {
-    if (def.info.complex)
-      impl_ = std::make_unique<Impl>(std::in_place_index<1>, make_integrator<VC>(def, f));
-    else
-      impl_ = std::make_unique<Impl>(std::in_place_index<0>, make_integrator<V>(def, f));
-  }
+  NBodyMethodStepper(const MethodDef& def, const NBodyForce<double>& f)
+      : info_(def.info), impl_(std::make_unique<RealStateIntegrator<V, NBodyForce<double>>>(def, f)) {}
   const MethodInfo& info() const { return info_; }
   /// n steps of size h, in place.
-  void integrate(State<V>& s, double h, long n) {
-    if (auto* r = std::get_if<0>(impl_.get())) {
-      r->integrate(s, h, n);
-    } else {
-      auto& c = std::get<1>(*impl_);
-      auto sc = convert_state<VC>(s);
-      c.integrate(sc, h, n);
-      s = convert_state<V>(sc);
-    }
-  }
-  long force_evals() const {
-    return std::visit([](const auto& e) { return e.force_evals(); }, *impl_);
-  }
+  void integrate(State<V>& s, double h, long n) { impl_->integrate(s, h, n); }
+  long force_evals() const { return impl_->force_evals(); }
 
  private:
-  using Impl = std::variant<Integrator<V, NBodyForce<double>>, Integrator<VC, NBodyForce<double>>>;
   MethodInfo info_;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<RealStateIntegrator<V, NBodyForce<double>>> impl_;
 };
 
 struct LocalErrConfig {

@@ -1,0 +1,818 @@
+// One driver for every method: solve(problem, method, options) integrates a SecondOrderProblem with any
+// catalog method or specification and returns a Solution.
+//
+//   auto prob = nystrom::SecondOrderProblem(force, q0, v0, 0.0, 20.0);       // force(q, a) or force(t, q, a)
+//   auto sol  = nystrom::solve(prob, "M8", {.steps = 2000});                  // fixed step (or .h = 0.01)
+//   auto sol  = nystrom::solve(prob, "DP12-adaptive", {.rtol = 1e-12});       // adaptive (also M10-adaptive, ...)
+//   auto sol  = nystrom::solve(prob, "GBS", {.rtol = 1e-12});                 // Gragg-Bulirsch-Stoer
+//   sol.t, sol.q, sol.v         saved times and states (options.t_eval, or every step end)
+//   sol(t)                      the state at any t of the span (dense output, solve/dense.hpp)
+//   sol.events                  located events (Event: g(t, q, v) = 0, direction, terminal)
+//   sol.force_evals, sol.accepted, sol.rejected, sol.status, sol.message
+//
+// solve() chooses the engine from the method once: splitting, RKN and multi-product methods with fixed
+// steps; adaptive RKN pairs and adaptive multi-product methods with a tolerance; GBS. Complex-coefficient
+// methods run on the complexified state and drop the imaginary parts after every step (the force must
+// then accept complex states: a generic lambda or a template operator()). Backward integration (t1 < t0)
+// integrates the time-reversed problem (v -> -v, t -> -t), so that every engine steps forward. A
+// time-dependent force a(t, q) runs as an autonomous one with t as one more coordinate (velocity 1,
+// acceleration 0): every method integrates it exactly (drifts move it by c h, RKN stages by c_i h), and a
+// time-independent force costs nothing more.
+//
+// Fixed steps: one engine call per step (Integrator::integrate(s, h, n) with n > 1 joins the last
+// sub-step of a step with the first of the next, which changes the rounding), so that the steps are the
+// same with or without outputs, events and checkpoints, and a restarted run is bitwise the
+// uninterrupted one.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "nystrom/core/error.hpp"
+#include "nystrom/core/state.hpp"
+#include "nystrom/engines/adaptive_mpe.hpp"
+#include "nystrom/engines/adaptive_rkn.hpp"
+#include "nystrom/engines/gbs.hpp"
+#include "nystrom/engines/integrator.hpp"
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/solve/checkpoint.hpp"
+#include "nystrom/solve/dense.hpp"
+#include "nystrom/solve/problem.hpp"
+
+namespace nystrom {
+
+struct SolveOptions {
+  /// Fixed step: the step size (the last step is shortened to end on t1), or the number of equal steps.
+  double h = 0;
+  long steps = 0;
+  /// Adaptive methods and GBS: the tolerance. The adaptive RKN and MPE engines use the mixed norm
+  /// sc_i = rtol (1 + |y_i|) (atol must be 0 or equal to rtol); GBS uses sc_i = atol + rtol |y_i|
+  /// (atol 0: atol = rtol).
+  double rtol = 0;
+  double atol = 0;
+  /// Output times, monotone in the direction of integration, within the span (from the dense output).
+  /// Empty: the state at every step end (and at t0).
+  std::vector<double> t_eval{};
+  /// Keep every step end for sol(t) (one force evaluation per step end where the method does not
+  /// provide it; counted in output_force_evals).
+  bool dense = true;
+  /// The largest number of steps (accepted and rejected).
+  long max_steps = 10000000;
+  /// Engine options (compensated summation, MPE schedule, keep_complex).
+  EngineOptions engine{};
+  /// Adaptive RKN and MPE controller (tol and max_steps are taken from above).
+  AdaptiveOptions adaptive{};
+  /// GBS (rtol, atol and max_steps are taken from above).
+  GbsOptions gbs{};
+  /// Take a checkpoint at the first step boundary at or after this time (NaN: none); the run goes on
+  /// unchanged. Solution::checkpoint holds it; checkpoint_problem is stored in it.
+  double checkpoint_at = std::numeric_limits<double>::quiet_NaN();
+  std::string checkpoint_problem{};
+  /// Called with the checkpoint as text (to_text; float, double and long double states) when it is
+  /// taken, if set: e.g. to write it to a file (write_checkpoint_text) while the run goes on.
+  std::function<void(const std::string& checkpoint_text)> on_checkpoint{};
+};
+
+/// An event function g(t, q, v): its zeros are located (direction: +1 rising only, -1 falling only,
+/// 0 both); a terminal event ends the integration there.
+template <class V>
+struct Event {
+  using real_type = real_t<typename V::value_type>;
+  std::string name;
+  std::function<real_type(const real_type& t, const V& q, const V& v)> g;
+  int direction = 0;
+  bool terminal = false;
+};
+
+template <class V>
+struct EventHit {
+  using real_type = real_t<typename V::value_type>;
+  std::string name;
+  std::size_t index = 0;  // which event
+  real_type t{};
+  V q, v;
+};
+
+enum class SolveStatus { success, terminated_by_event };
+
+template <class V>
+struct Solution {
+  using real_type = real_t<typename V::value_type>;
+  std::vector<real_type> t;
+  std::vector<V> q, v;
+  /// The state where the integration ended (t1, or a terminal event).
+  real_type t_final{};
+  V q_final, v_final;
+  long force_evals = 0;         // by the method: every stage, rejected steps and starting-step estimates
+  long output_force_evals = 0;  // at step ends for the dense output and events
+  long accepted = 0, rejected = 0;
+  SolveStatus status = SolveStatus::success;
+  std::string message;
+  std::vector<EventHit<V>> events;
+  DenseOutput<V> dense;
+  std::optional<Checkpoint<real_type>> checkpoint;
+
+  /// The state at any t within the integrated span.
+  State<V> operator()(const real_type& tt) const { return dense(tt); }
+};
+
+namespace solve_detail {
+
+/// The vector the engines integrate: V (or its complex counterpart) with one more coordinate for t
+/// when the force is time-dependent.
+template <class V, bool Extend>
+struct extended;
+template <class V>
+struct extended<V, false> {
+  using type = V;
+};
+template <class S, std::size_t N>
+struct extended<std::array<S, N>, true> {
+  using type = std::array<S, N + 1>;
+};
+template <class S, class A>
+struct extended<std::vector<S, A>, true> {
+  using type = std::vector<S>;
+};
+
+/// The force on the engine's vector: the user's force, time-reversed for backward integration
+/// (dir = -1: t = -tau) and with t read from the extra coordinate when it is time-dependent.
+template <class V, class VE, class F, bool TD>
+struct EngineForce {
+  F f;
+  int dir = 1;
+  std::size_t n = 0;
+  V qb{}, ab{};
+  void operator()(const VE& q, VE& a) {
+    if constexpr (!TD) {
+      f(q, a);
+    } else {
+      using R = real_t<typename V::value_type>;
+      resize_like_n(qb, n);
+      resize_like_n(ab, n);
+      for (std::size_t i = 0; i < n; ++i) qb[i] = q[i];
+      const R t = dir > 0 ? R(q[n]) : R(-q[n]);
+      f(t, static_cast<const V&>(qb), ab);
+      for (std::size_t i = 0; i < n; ++i) a[i] = ab[i];
+      a[n] = typename VE::value_type(0);
+    }
+  }
+  static void resize_like_n(V& x, std::size_t m) {
+    if constexpr (!is_std_array<V>::value) {
+      if (x.size() != m) x.resize(m);
+    } else {
+      (void)x, (void)m;
+    }
+  }
+};
+
+template <class VE>
+VE make_vector(std::size_t m) {
+  VE x{};
+  if constexpr (!is_std_array<VE>::value) x.resize(m);
+  return x;
+}
+
+template <class T>
+T sgn_mul(int dir, const T& x) {
+  return dir > 0 ? x : T(-x);
+}
+
+/// Flattens an engine vector of real or complex scalars into reals.
+template <class T, class VE>
+void flatten(const VE& x, std::vector<T>& out) {
+  for (const auto& e : x) {
+    if constexpr (is_complex_v<std::decay_t<decltype(e)>>) {
+      out.push_back(e.real());
+      out.push_back(e.imag());
+    } else {
+      out.push_back(e);
+    }
+  }
+}
+template <class T, class VE>
+std::size_t unflatten(const std::vector<T>& in, std::size_t pos, VE& x) {
+  for (auto& e : x) {
+    if (pos >= in.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
+    if constexpr (is_complex_v<std::decay_t<decltype(e)>>) {
+      if (pos + 1 >= in.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
+      e = typename VE::value_type(in[pos], in[pos + 1]);
+      pos += 2;
+    } else {
+      e = in[pos++];
+    }
+  }
+  return pos;
+}
+
+/// Receives every accepted step end (user time and state), keeps the dense output, the saved states
+/// and the events, and says when a terminal event stops the run.
+template <class V, class P>
+class Recorder {
+ public:
+  using R = real_t<typename V::value_type>;
+
+  Recorder(P& prob, const SolveOptions& opt, const std::vector<Event<V>>& events, Solution<V>& sol, int dir)
+      : prob_(prob), opt_(opt), events_(events), sol_(sol), dir_(dir) {
+    need_a_ = opt.dense || !events.empty() || !opt.t_eval.empty();
+    for (const auto& e : events_)
+      if (!e.g) throw invalid_input("event '" + e.name + "' has no function");
+  }
+
+  void start(const R& t, const V& q, const V& v) {
+    tp_ = t;
+    qp_ = q;
+    vp_ = v;
+    ap_ = q;
+    if (need_a_) accel(t, q, ap_);
+    if (opt_.dense) sol_.dense.push(t, q, v, ap_);
+    gp_.clear();
+    for (const auto& e : events_) gp_.push_back(e.g(t, q, v));
+    if (opt_.t_eval.empty()) {
+      save(t, q, v);
+    } else {
+      while (next_ < opt_.t_eval.size() && R(opt_.t_eval[next_]) == t) save(t, q, v), ++next_;
+    }
+  }
+
+  /// A step ended at (t, q, v); true when a terminal event ends the run inside it (the solution's
+  /// final state is then set to the event's).
+  bool step(const R& t, const V& q, const V& v) {
+    V a = q;
+    if (need_a_) accel(t, q, a);
+    // Events in this step, the earliest first.
+    std::vector<std::pair<R, std::size_t>> hits;
+    std::vector<R> g(events_.size());
+    for (std::size_t i = 0; i < events_.size(); ++i) {
+      g[i] = events_[i].g(t, q, v);
+      const R g0 = gp_[i], g1 = g[i];
+      const bool rising = g0 < R(0) && g1 >= R(0);
+      const bool falling = g0 > R(0) && g1 <= R(0);
+      const int d = events_[i].direction * dir_;  // in the direction of integration
+      if ((rising && d >= 0) || (falling && d <= 0)) hits.push_back({locate(i, t, q, v, a, g0, g1), i});
+    }
+    std::sort(hits.begin(), hits.end(), [&](const auto& x, const auto& y) { return dir_ * x.first < dir_ * y.first; });
+    bool terminal = false;
+    R t_end = t;
+    for (const auto& [te, i] : hits) {
+      State<V> s = interpolate(t, q, v, a, te);
+      sol_.events.push_back({events_[i].name, i, te, s.q, s.v});
+      if (events_[i].terminal) {
+        terminal = true;
+        t_end = te;
+        sol_.t_final = te;
+        sol_.q_final = s.q;
+        sol_.v_final = s.v;
+        sol_.status = SolveStatus::terminated_by_event;
+        sol_.message = "terminated by event '" + events_[i].name + "'";
+        break;
+      }
+    }
+    // Output times in (tp, t_end].
+    if (opt_.t_eval.empty()) {
+      if (!terminal) save(t, q, v);
+    } else {
+      while (next_ < opt_.t_eval.size() && dir_ * R(opt_.t_eval[next_]) <= dir_ * t_end) {
+        const R te = R(opt_.t_eval[next_++]);
+        if (te == t) {
+          save(t, q, v);
+        } else {
+          State<V> s = interpolate(t, q, v, a, te);
+          save(te, s.q, s.v);
+        }
+      }
+    }
+    if (opt_.dense) {
+      if (terminal)
+        sol_.dense.push(t_end, sol_.q_final, sol_.v_final, accel_copy(t_end, sol_.q_final));
+      else
+        sol_.dense.push(t, q, v, a);
+    }
+    tp_ = t;
+    assign_v(qp_, q);
+    assign_v(vp_, v);
+    assign_v(ap_, a);
+    gp_ = g;
+    return terminal;
+  }
+
+ private:
+  static void assign_v(V& x, const V& y) {
+    resize_like(x, y);
+    assign(x, y);
+  }
+  void accel(const R& t, const V& q, V& a) {
+    resize_like(a, q);
+    prob_.acceleration(t, q, a);
+    ++sol_.output_force_evals;
+  }
+  V accel_copy(const R& t, const V& q) {
+    V a = q;
+    accel(t, q, a);
+    return a;
+  }
+  void save(const R& t, const V& q, const V& v) {
+    sol_.t.push_back(t);
+    sol_.q.push_back(q);
+    sol_.v.push_back(v);
+  }
+  State<V> interpolate(const R& t, const V& q, const V& v, const V& a, const R& te) const {
+    State<V> s;
+    const R h = t - tp_;
+    hermite_quintic(qp_, vp_, ap_, q, v, a, h, R((te - tp_) / h), s.q, s.v);
+    return s;
+  }
+  // The zero of event i in (tp, t) on the dense output: the Illinois variant of regula falsi, to a few
+  // units of rounding of t (or 200 iterations).
+  R locate(std::size_t i, const R& t, const V& q, const V& v, const V& a, R ga, R gb) {
+    using std::abs;
+    R lo = tp_, hi = t;
+    if (gb == R(0)) return t;
+    int side = 0;
+    const R eps = epsilon_of<R>();
+    for (int it = 0; it < 200; ++it) {
+      if (abs(hi - lo) <= R(4) * eps * std::max(abs(lo), abs(hi))) break;
+      R m = (lo * gb - hi * ga) / (gb - ga);
+      if (!((m - lo) * (hi - m) > R(0))) m = (lo + hi) / R(2);  // strictly inside the bracket
+      const State<V> s = interpolate(t, q, v, a, m);
+      const R gm = events_[i].g(m, s.q, s.v);
+      if (gm == R(0)) return m;
+      if ((gm < R(0)) == (ga < R(0))) {
+        lo = m;
+        ga = gm;
+        if (side == -1) gb /= R(2);
+        side = -1;
+      } else {
+        hi = m;
+        gb = gm;
+        if (side == 1) ga /= R(2);
+        side = 1;
+      }
+    }
+    return abs(ga) < abs(gb) ? lo : hi;
+  }
+
+  P& prob_;
+  const SolveOptions& opt_;
+  const std::vector<Event<V>>& events_;
+  Solution<V>& sol_;
+  int dir_;
+  bool need_a_ = true;
+  std::size_t next_ = 0;
+  R tp_{};
+  V qp_{}, vp_{}, ap_{};
+  std::vector<R> gp_;
+};
+
+/// Common state of a run: problem, options, direction, conversions between the user's state and the
+/// engine's.
+template <class V, class F, class VE>
+struct Run {
+  using R = real_t<typename V::value_type>;
+  using S = typename VE::value_type;
+  static constexpr bool td = SecondOrderProblem<V, F>::time_dependent;
+
+  SecondOrderProblem<V, F>& prob;
+  const SolveOptions& opt;
+  int dir;
+  std::size_t n;
+  std::string method;
+
+  /// Completes a checkpoint just taken and hands it to the solution and the options' callback.
+  void take(Checkpoint<R>& c, Solution<V>& sol) const {
+    c.method = method;
+    c.problem = opt.checkpoint_problem;
+    if constexpr (checkpoint_detail::exact_text<R>) {
+      if (opt.on_checkpoint) opt.on_checkpoint(to_text(c));
+    }
+    sol.checkpoint = c;
+  }
+
+  State<VE> to_engine(const R& t, const V& q, const V& v) const {
+    State<VE> s{make_vector<VE>(n + (td ? 1 : 0)), make_vector<VE>(n + (td ? 1 : 0))};
+    for (std::size_t i = 0; i < n; ++i) {
+      s.q[i] = S(q[i]);
+      s.v[i] = S(sgn_mul(dir, v[i]));
+    }
+    if constexpr (td) {
+      s.q[n] = S(sgn_mul(dir, t));
+      s.v[n] = S(1);
+    }
+    return s;
+  }
+  void from_engine(const State<VE>& s, V& q, V& v) const {
+    q = make_vector<V>(n);
+    v = make_vector<V>(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      if constexpr (is_complex_v<S>) {
+        q[i] = s.q[i].real();
+        v[i] = sgn_mul(dir, R(s.v[i].real()));
+      } else {
+        q[i] = s.q[i];
+        v[i] = sgn_mul(dir, s.v[i]);
+      }
+    }
+  }
+  EngineForce<V, VE, F, td> force() const { return {prob.force, dir, n, {}, {}}; }
+  void check_finite(const V& q, const V& v, const R& ta, const R& tb) const {
+    if (!all_finite(q) || !all_finite(v))
+      throw error("the state became NaN or infinite in the step from t = " + adaptive_detail::sci(as_double(ta)) +
+                  " to t = " + adaptive_detail::sci(as_double(tb)) + " (the force returned NaN or infinity)");
+  }
+};
+
+template <class VE, class V, class F>
+void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
+               const std::vector<Event<V>>& events, Solution<V>& sol, int dir,
+               const Checkpoint<real_t<typename V::value_type>>* resume) {
+  using R = real_t<typename V::value_type>;
+  Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
+  const R span = prob.t1 - prob.t0;
+  const R aspan = dir > 0 ? span : R(-span);
+  long n;
+  R h;
+  if (opt.steps > 0) {
+    n = opt.steps;
+    h = aspan / R(n);
+  } else {
+    if (!(opt.h > 0) || !std::isfinite(opt.h))
+      throw invalid_input("a fixed-step method needs a positive step size h or a number of steps");
+    h = R(opt.h);
+    const double nd = std::ceil(as_double(aspan) / opt.h * (1 - 1e-12));
+    if (nd > 1e15) throw invalid_input("the step size is too small for the span");
+    n = std::max(1L, static_cast<long>(nd));
+  }
+  if (n > opt.max_steps) throw too_many_steps("the span needs " + std::to_string(n) + " steps, more than max_steps");
+  auto integ = make_integrator<VE>(def, run.force(), opt.engine);
+  const R tau0 = sgn_mul(dir, prob.t0), tau1 = sgn_mul(dir, prob.t1);
+  State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
+  long k0 = 0;
+  long evals0 = 0;
+  Recorder<V, SecondOrderProblem<V, F>> rec(prob, opt, events, sol, dir);
+  if (resume) {
+    if (resume->engine != "fixed") throw invalid_input("checkpoint of another engine (" + resume->engine + ")");
+    k0 = resume->step_index;
+    if (k0 < 0 || k0 > n) throw invalid_input("checkpoint step index outside the run");
+    std::size_t pos = unflatten(resume->state, 0, s.q);
+    pos = unflatten(resume->state, pos, s.v);
+    if (pos != resume->state.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
+    if (!resume->carry.empty()) {
+      VE cq = s.q, cv = s.v;
+      std::size_t p2 = unflatten(resume->carry, 0, cq);
+      p2 = unflatten(resume->carry, p2, cv);
+      if (p2 != resume->carry.size()) throw invalid_input("checkpoint: the carries have the wrong size");
+      integ.compensator().restore(cq, cv, s);
+    }
+    evals0 = resume->force_evals;
+    sol.output_force_evals = resume->output_force_evals;
+  }
+  V q, v;
+  run.from_engine(s, q, v);
+  const R tstart = resume ? resume->t : prob.t0;
+  rec.start(tstart, q, v);
+  bool taken = !std::isfinite(opt.checkpoint_at);
+  R tprev = tstart;
+  for (long k = k0; k < n; ++k) {
+    // The last step of a given h ends on t1.
+    const R hk = (opt.steps <= 0 && k == n - 1) ? R((tau1 - tau0) - h * R(n - 1)) : h;
+    integ.integrate(s, hk, 1);
+    const R t = k == n - 1 ? prob.t1 : sgn_mul(dir, R(tau0 + h * R(k + 1)));
+    run.from_engine(s, q, v);
+    run.check_finite(q, v, tprev, t);
+    sol.accepted = k + 1;
+    if (rec.step(t, q, v)) break;
+    tprev = t;
+    if (!taken && dir * as_double(t) >= dir * opt.checkpoint_at && k + 1 < n) {
+      taken = true;
+      Checkpoint<R> c;
+      c.engine = "fixed";
+      c.t = t;
+      c.step_index = k + 1;
+      flatten(s.q, c.state);
+      flatten(s.v, c.state);
+      if (use_compensation<typename VE::value_type>(opt.engine.compensated)) {
+        flatten(integ.compensator().cq, c.carry);
+        flatten(integ.compensator().cv, c.carry);
+      }
+      c.force_evals = evals0 + integ.force_evals();
+      c.output_force_evals = sol.output_force_evals;
+      c.accepted = k + 1;
+      run.take(c, sol);
+    }
+  }
+  sol.force_evals = evals0 + integ.force_evals();
+  if (sol.status == SolveStatus::success) {
+    sol.t_final = prob.t1;
+    sol.q_final = q;
+    sol.v_final = v;
+  }
+}
+
+/// Adaptive RKN or MPE (Engine: AdaptiveRknIntegrator or AdaptiveMpeIntegrator on VE).
+template <class VE, class V, class F, class Engine>
+void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, Solution<V>& sol,
+                  const std::vector<Event<V>>& events, const Checkpoint<real_t<typename V::value_type>>* resume) {
+  using R = real_t<typename V::value_type>;
+  auto& prob = run.prob;
+  const int dir = run.dir;
+  const R tau0 = sgn_mul(dir, prob.t0), tau1 = sgn_mul(dir, prob.t1);
+  State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
+  long evals0 = 0, acc0 = 0, rej0 = 0;
+  R tau = tau0;
+  if (resume) {
+    if (resume->engine != name) throw invalid_input(std::string("checkpoint of another engine (") + resume->engine + ")");
+    std::size_t pos = unflatten(resume->state, 0, s.q);
+    pos = unflatten(resume->state, pos, s.v);
+    if (pos != resume->state.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
+    if constexpr (requires { engine.compensator(); }) {
+      if (!resume->carry.empty()) {
+        VE cq = s.q, cv = s.v;
+        std::size_t p2 = unflatten(resume->carry, 0, cq);
+        p2 = unflatten(resume->carry, p2, cv);
+        if (p2 != resume->carry.size()) throw invalid_input("checkpoint: the carries have the wrong size");
+        engine.compensator().restore(cq, cv, s);
+      }
+    }
+    tau = sgn_mul(dir, resume->t);
+    engine.set_resume_point({tau, resume->h_want, resume->hmax, resume->last_rejected, resume->q_prev,
+                             resume->h_prev, true});
+    evals0 = resume->force_evals;
+    acc0 = resume->accepted;
+    rej0 = resume->rejected;
+    sol.output_force_evals = resume->output_force_evals;
+  }
+  Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir);
+  V q, v;
+  run.from_engine(s, q, v);
+  rec.start(sgn_mul(dir, tau), q, v);
+  bool taken = !std::isfinite(run.opt.checkpoint_at);
+  bool terminal = false, want_checkpoint = false;
+  R tprev = sgn_mul(dir, tau);
+  auto obs = [&](const R& tt, const State<VE>& st) -> bool {
+    if (tt == tau) return false;  // the start
+    const R t = tt == tau1 ? prob.t1 : sgn_mul(dir, tt);
+    run.from_engine(st, q, v);
+    run.check_finite(q, v, tprev, t);
+    tprev = t;
+    if (rec.step(t, q, v)) {
+      terminal = true;
+      return true;
+    }
+    if (!taken && dir * as_double(t) >= dir * run.opt.checkpoint_at) {
+      taken = true;
+      want_checkpoint = true;
+      return true;
+    }
+    return false;
+  };
+  for (;;) {
+    want_checkpoint = false;
+    engine.integrate_to(s, tau, tau1, obs);
+    if (terminal || !want_checkpoint) break;
+    const auto& rp = engine.resume_point();
+    Checkpoint<R> c;
+    c.engine = name;
+    c.t = sgn_mul(dir, rp.t);
+    flatten(s.q, c.state);
+    flatten(s.v, c.state);
+    if constexpr (requires { engine.compensator(); }) {
+      if (use_compensation<typename VE::value_type>(run.opt.engine.compensated)) {
+        flatten(engine.compensator().cq, c.carry);
+        flatten(engine.compensator().cv, c.carry);
+      }
+    }
+    c.h_want = rp.h_want;
+    c.hmax = rp.hmax;
+    c.last_rejected = rp.last_rejected;
+    c.q_prev = rp.q_prev;
+    c.h_prev = rp.h_prev;
+    c.force_evals = evals0 + engine.total().force_evals;
+    c.output_force_evals = sol.output_force_evals;
+    c.accepted = acc0 + engine.total().accepted;
+    c.rejected = rej0 + engine.total().rejected;
+    run.take(c, sol);
+    tau = rp.t;  // go on from the resume point: the same steps as without the stop
+  }
+  sol.force_evals = evals0 + engine.total().force_evals;
+  sol.accepted = acc0 + engine.total().accepted;
+  sol.rejected = rej0 + engine.total().rejected;
+  if (sol.status == SolveStatus::success) {
+    sol.t_final = prob.t1;
+    sol.q_final = q;
+    sol.v_final = v;
+  }
+}
+
+template <class VE, class V, class F>
+void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& events,
+             const Checkpoint<real_t<typename V::value_type>>* resume) {
+  using R = real_t<typename V::value_type>;
+  auto& prob = run.prob;
+  const int dir = run.dir;
+  GbsOptions go = run.opt.gbs;
+  go.rtol = run.opt.rtol;
+  go.atol = run.opt.atol > 0 ? run.opt.atol : run.opt.rtol;
+  go.max_steps = run.opt.max_steps;
+  GbsIntegrator<VE, decltype(run.force())> g(run.force(), go);
+  const R tau0 = sgn_mul(dir, prob.t0);
+  const R span = sgn_mul(dir, R(prob.t1 - prob.t0));
+  State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
+  R t_start = prob.t0;
+  long evals0 = 0;
+  if (resume) {
+    if (resume->engine != "gbs") throw invalid_input("checkpoint of another engine (" + resume->engine + ")");
+    std::size_t pos = unflatten(resume->state, 0, s.q);
+    pos = unflatten(resume->state, pos, s.v);
+    if (pos != resume->state.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
+    g.set_resume_point({resume->span, span, resume->h_want, resume->columns, resume->last_rejected, true});
+    g.set_counters(resume->force_evals, resume->accepted, resume->rejected);
+    t_start = resume->t;
+    sol.output_force_evals = resume->output_force_evals;
+  }
+  (void)evals0;
+  Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir);
+  V q, v;
+  run.from_engine(s, q, v);
+  rec.start(t_start, q, v);
+  bool taken = !std::isfinite(run.opt.checkpoint_at);
+  bool terminal = false, want_checkpoint = false;
+  R tprev = t_start;
+  auto obs = [&](const R& trel, const State<VE>& st) -> bool {
+    const R t = trel == span ? prob.t1 : sgn_mul(dir, R(tau0 + trel));
+    run.from_engine(st, q, v);
+    run.check_finite(q, v, tprev, t);
+    tprev = t;
+    if (rec.step(t, q, v)) {
+      terminal = true;
+      return true;
+    }
+    if (!taken && dir * as_double(t) >= dir * run.opt.checkpoint_at) {
+      taken = true;
+      want_checkpoint = true;
+      return true;
+    }
+    return false;
+  };
+  for (;;) {
+    want_checkpoint = false;
+    g.integrate_to(s, span, obs);
+    if (terminal || !want_checkpoint) break;
+    const auto& rp = g.resume_point();
+    Checkpoint<R> c;
+    c.engine = "gbs";
+    c.t = sgn_mul(dir, R(tau0 + rp.t));
+    c.span = rp.t;
+    flatten(s.q, c.state);
+    flatten(s.v, c.state);
+    c.h_want = rp.H;
+    c.columns = rp.k;
+    c.last_rejected = rp.last_rejected;
+    c.force_evals = g.force_evals();
+    c.output_force_evals = sol.output_force_evals;
+    c.accepted = g.steps();
+    c.rejected = g.rejected();
+    run.take(c, sol);
+  }
+  sol.force_evals = g.force_evals();
+  sol.accepted = g.steps();
+  sol.rejected = g.rejected();
+  if (sol.status == SolveStatus::success) {
+    sol.t_final = prob.t1;
+    sol.q_final = q;
+    sol.v_final = v;
+  }
+}
+
+template <class V, class F>
+Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef& def, const SolveOptions& opt,
+                       const std::vector<Event<V>>& events, const Checkpoint<real_t<typename V::value_type>>* resume) {
+  using R = real_t<typename V::value_type>;
+  using P = SecondOrderProblem<V, F>;
+  constexpr bool td = P::time_dependent;
+  problem.validate();
+  if (opt.max_steps <= 0) throw invalid_input("max_steps must be positive");
+  P prob = problem;
+  const int dir = prob.t1 >= prob.t0 ? 1 : -1;
+  // Output times: within the span and monotone in the direction of integration.
+  for (std::size_t i = 0; i < opt.t_eval.size(); ++i) {
+    const double te = opt.t_eval[i];
+    if (!std::isfinite(te)) throw invalid_input("output times must be finite");
+    if (sgn_mul(dir, R(te)) < sgn_mul(dir, prob.t0))
+      throw invalid_input("output time " + adaptive_detail::sci(te) + " lies before t0");
+    if (sgn_mul(dir, R(te)) > sgn_mul(dir, prob.t1)) throw invalid_input("output time " + adaptive_detail::sci(te) + " lies after t1");
+    if (i > 0 && dir * te < dir * opt.t_eval[i - 1])
+      throw invalid_input("output times must be ordered in the direction of integration");
+  }
+  if (!std::isnan(opt.checkpoint_at) && !std::isfinite(opt.checkpoint_at))
+    throw invalid_input("the checkpoint time must be finite");
+  Solution<V> sol;
+  if (resume && resume->problem != opt.checkpoint_problem)
+    throw invalid_input("the checkpoint was taken for another problem ('" + resume->problem + "', not '" +
+                        opt.checkpoint_problem + "')");
+  if (resume && resume->method != def.info.name)
+    throw invalid_input("the checkpoint was taken with method '" + resume->method + "', not '" + def.info.name + "'");
+  if (prob.t1 == prob.t0) {
+    Recorder<V, P> rec(prob, opt, events, sol, dir);
+    rec.start(prob.t0, prob.q0, prob.v0);
+    sol.t_final = prob.t0;
+    sol.q_final = prob.q0;
+    sol.v_final = prob.v0;
+    return sol;
+  }
+  using VE = typename extended<V, td>::type;
+  const bool gbs = def.info.name == "GBS" || def.info.family == "extrapolation";
+  if (gbs || def.info.adaptive) {
+    if (!(opt.rtol > 0) || !std::isfinite(opt.rtol))
+      throw invalid_input("method '" + def.info.name + "' needs a positive finite tolerance (rtol)");
+    if (!(opt.atol >= 0) || !std::isfinite(opt.atol)) throw invalid_input("atol must be finite and >= 0");
+    Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
+    if (gbs) {
+      run_gbs<VE>(run, sol, events, resume);
+    } else {
+      if (opt.atol != 0 && opt.atol != opt.rtol)
+        throw invalid_input("the adaptive RKN and MPE engines take one tolerance (rtol; atol = rtol or 0)");
+      AdaptiveOptions ao = opt.adaptive;
+      ao.tol = opt.rtol;
+      ao.max_steps = opt.max_steps;
+      if (std::holds_alternative<MpeDef>(def.build())) {
+        auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);
+        run_adaptive<VE>(run, engine, "adaptive-mpe", sol, events, resume);
+      } else {
+        auto engine = make_adaptive_integrator<VE>(def, run.force(), ao);
+        run_adaptive<VE>(run, engine, "adaptive-rkn", sol, events, resume);
+      }
+    }
+  } else if (def.info.complex) {
+    using C = std::complex<R>;
+    using VC = rebind_vector_t<V, C>;
+    if constexpr (!td && std::is_invocable_v<F&, const VC&, VC&>) {
+      run_fixed<VC>(prob, def, opt, events, sol, dir, resume);
+    } else {
+      throw invalid_input("method '" + def.info.name +
+                          "' has complex coefficients: its force must accept complex states (a generic lambda or a "
+                          "template operator()) and not depend on time");
+    }
+  } else {
+    run_fixed<VE>(prob, def, opt, events, sol, dir, resume);
+  }
+  return sol;
+}
+
+}  // namespace solve_detail
+
+/// Integrates `problem` with `method` (a catalog entry or specification, see resolve_method) and returns
+/// the solution. Throws invalid_input for a problem or options that cannot be integrated,
+/// step_size_underflow / too_many_steps when an adaptive run cannot go on, nystrom::error when the
+/// state becomes NaN or infinite.
+template <class V, class F>
+Solution<V> solve(const SecondOrderProblem<V, F>& problem, const MethodDef& method, const SolveOptions& options = {},
+                  const std::vector<Event<V>>& events = {}) {
+  return solve_detail::solve_impl(problem, method, options, events, nullptr);
+}
+/// The Gragg-Bulirsch-Stoer extrapolation integrator (engines/gbs.hpp) as a method for solve(): adaptive
+/// step and order, tolerances rtol and atol.
+inline MethodDef gbs_method_def() {
+  MethodDef d;
+  d.info.name = "GBS";
+  d.info.family = "extrapolation";
+  d.info.adaptive = true;
+  d.info.source = "Gragg (1965); Bulirsch & Stoer (1966); Hairer, Norsett & Wanner I, sec. II.9/II.14 (ODEX2)";
+  d.info.description = "Gragg-Bulirsch-Stoer extrapolation, adaptive step and order";
+  d.build = []() -> MethodData { throw invalid_input("GBS has no coefficient table"); };
+  return d;
+}
+
+/// resolve_method(spec), and "GBS" (or "gbs") for the extrapolation integrator.
+inline MethodDef resolve_solve_method(const std::string& spec) {
+  if (spec == "GBS" || spec == "gbs") return gbs_method_def();
+  return resolve_method(spec);
+}
+
+template <class V, class F>
+Solution<V> solve(const SecondOrderProblem<V, F>& problem, const std::string& method, const SolveOptions& options = {},
+                  const std::vector<Event<V>>& events = {}) {
+  return solve_detail::solve_impl(problem, resolve_solve_method(method), options, events, nullptr);
+}
+
+/// Continues a run from a checkpoint (Solution::checkpoint) to problem.t1: the same problem, method and
+/// options as the run that took it (the method and options.checkpoint_problem are checked); the result
+/// is bitwise that of the run that was never interrupted. The problem's q0, v0 are not used.
+template <class V, class F>
+Solution<V> resume(const SecondOrderProblem<V, F>& problem, const MethodDef& method,
+                   const Checkpoint<real_t<typename V::value_type>>& from, const SolveOptions& options = {},
+                   const std::vector<Event<V>>& events = {}) {
+  return solve_detail::solve_impl(problem, method, options, events, &from);
+}
+
+}  // namespace nystrom

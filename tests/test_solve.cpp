@@ -1,0 +1,335 @@
+// solve(): one driver for every method family, its options, dense output, events and checkpoints.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "nystrom/problems/kepler.hpp"
+#include "nystrom/solve.hpp"
+
+using namespace nystrom;
+using V2 = std::array<double, 2>;
+using Vd = std::vector<double>;
+// One force type for the tests of user-written forces on a std::vector state (each force type compiles
+// every engine once more); the capturing-lambda test keeps its own lambda type.
+using VdForce = std::function<void(const Vd&, Vd&)>;
+using VdTimeForce = std::function<void(double, const Vd&, Vd&)>;
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+SecondOrderProblem<V2, KeplerForce> kepler(double e, double t0, double t1) {
+  const auto s = KeplerProblem<double>(e).initial_state();
+  return SecondOrderProblem(KeplerForce{}, s.q, s.v, t0, t1);
+}
+
+double pos_err(const V2& q, const State<V2>& ex) { return std::hypot(q[0] - ex.q[0], q[1] - ex.q[1]); }
+
+}  // namespace
+
+TEST(Solve, EveryFamilyReachesTheAnalyticKeplerOrbit) {
+  const KeplerProblem<double> kp(0.5);
+  const double t1 = 2.5;  // not a multiple of the period
+  const auto prob = kepler(0.5, 0.0, t1);
+  const auto ex = kp.exact(t1);
+  struct Case {
+    std::string method;
+    SolveOptions opt;
+    double tol;
+  };
+  const std::vector<Case> cases = {
+      {"VV", {.steps = 20000}, 1e-6},          {"FR", {.steps = 2000}, 1e-6},
+      {"M8", {.steps = 400}, 1e-9},            {"A6", {.h = 0.003}, 1e-9},
+      {"DP12-adaptive", {.rtol = 1e-12}, 1e-9}, {"M12-adaptive", {.rtol = 1e-12}, 1e-9},
+      {"GBS", {.rtol = 1e-12}, 1e-9},          {"Chambers", {.steps = 20000}, 1e-6},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.method);
+    const auto sol = solve(prob, c.method, c.opt);
+    EXPECT_EQ(sol.status, SolveStatus::success);
+    EXPECT_EQ(sol.t_final, t1);
+    EXPECT_LT(pos_err(sol.q_final, ex), c.tol);
+    EXPECT_GT(sol.force_evals, 0);
+    EXPECT_GT(sol.accepted, 0);
+    // Every step end is saved (no t_eval), from t0 to t1.
+    ASSERT_EQ(sol.t.size(), static_cast<std::size_t>(sol.accepted + 1));
+    EXPECT_EQ(sol.t.front(), 0.0);
+    EXPECT_EQ(sol.t.back(), t1);
+  }
+}
+
+TEST(Solve, FixedStepCountsAndStepSizeLandOnTheEnd) {
+  const auto prob = kepler(0.2, 0.0, 1.0);
+  const auto a = solve(prob, "VV", {.steps = 100});
+  EXPECT_EQ(a.accepted, 100);
+  // Velocity Verlet is FSAL: one force per step plus the first.
+  EXPECT_EQ(a.force_evals, 101);
+  const auto b = solve(prob, "VV", {.h = 0.03});  // 34 steps, the last one shortened
+  EXPECT_EQ(b.accepted, 34);
+  EXPECT_EQ(b.t.back(), 1.0);
+  EXPECT_NEAR(b.t[33], 0.99, 1e-15);
+}
+
+TEST(Solve, BackwardInTimeRetracesTheOrbit) {
+  const KeplerProblem<double> kp(0.5);
+  const auto ex = kp.exact(3.0);
+  const auto back = SecondOrderProblem(KeplerForce{}, ex.q, ex.v, 3.0, 0.0);
+  const auto s0 = kp.initial_state();
+  for (const std::string m : {"DP12-adaptive", "M10-adaptive", "GBS", "M8"}) {
+    SCOPED_TRACE(m);
+    SolveOptions o{.rtol = 1e-12};
+    if (m == "M8") o = {.steps = 600};
+    const auto sol = solve(back, m, o);
+    EXPECT_EQ(sol.t_final, 0.0);
+    EXPECT_LT(pos_err(sol.q_final, s0), 1e-9);
+    EXPECT_LT(std::hypot(sol.v_final[0] - s0.v[0], sol.v_final[1] - s0.v[1]), 1e-9);
+    // Times decrease.
+    for (std::size_t i = 1; i < sol.t.size(); ++i) EXPECT_LT(sol.t[i], sol.t[i - 1]);
+  }
+}
+
+TEST(Solve, TimeDependentForceMatchesTheForcedOscillator) {
+  // q'' = -q + cos(2t), q(0) = 0, q'(0) = 0: q = (cos t - cos 2t) / 3.
+  VdTimeForce f = [](double t, const Vd& q, Vd& a) { a[0] = -q[0] + std::cos(2 * t); };
+  const SecondOrderProblem prob(f, Vd{0.0}, Vd{0.0}, 0.0, 5.0);
+  const double exact = (std::cos(5.0) - std::cos(10.0)) / 3;
+  const double exact_v = (-std::sin(5.0) + 2 * std::sin(10.0)) / 3;
+  for (const std::string m : {"M8", "RKNb6", "A6", "DP12-adaptive", "M12-adaptive", "GBS"}) {
+    SCOPED_TRACE(m);
+    const auto sol = solve(prob, m, {.steps = 500, .rtol = 1e-12});
+    EXPECT_NEAR(sol.q_final[0], exact, 1e-9);
+    EXPECT_NEAR(sol.v_final[0], exact_v, 1e-9);
+  }
+  // And backward from the end to the start.
+  const SecondOrderProblem back(f, Vd{exact}, Vd{exact_v}, 5.0, 0.0);
+  const auto b = solve(back, "DP12-adaptive", {.rtol = 1e-12});
+  EXPECT_NEAR(b.q_final[0], 0.0, 1e-9);
+  EXPECT_NEAR(b.v_final[0], 0.0, 1e-9);
+}
+
+TEST(Solve, CapturingLambdaOnAVectorStateRunsEveryEngineAndSchedule) {
+  // The harmonic oscillator with a captured frequency (a functor that cannot be copy-assigned).
+  const double w = 2.0;
+  auto f = [w](const std::vector<double>& q, std::vector<double>& a) {
+    for (std::size_t i = 0; i < q.size(); ++i) a[i] = -w * w * q[i];
+  };
+  const SecondOrderProblem prob(f, std::vector<double>{1.0, 0.0}, std::vector<double>{0.0, w}, 0.0, 1.0);
+  SolveOptions o{.steps = 200};
+  o.engine.mpe_schedule = MpeSchedule::concurrent;
+  for (const std::string m : {"M8", "FR", "N4", "DP12-adaptive", "M10-adaptive"}) {
+    SCOPED_TRACE(m);
+    o.rtol = 1e-12;
+    if (m == "M10-adaptive") o.engine.mpe_schedule = MpeSchedule::automatic;
+    const auto sol = solve(prob, m, o);
+    EXPECT_NEAR(sol.q_final[0], std::cos(w), 1e-7);
+    EXPECT_NEAR(sol.q_final[1], std::sin(w), 1e-7);
+  }
+}
+
+TEST(Solve, OutputTimesComeFromTheDenseOutput) {
+  const KeplerProblem<double> kp(0.5);
+  const auto prob = kepler(0.5, 0.0, 2 * pi);
+  std::vector<double> te;
+  for (int i = 0; i <= 50; ++i) te.push_back(2 * pi * i / 50);
+  const auto sol = solve(prob, "M8", {.steps = 2000, .t_eval = te});
+  ASSERT_EQ(sol.t.size(), te.size());
+  for (std::size_t i = 0; i < te.size(); ++i) {
+    EXPECT_EQ(sol.t[i], te[i]);
+    EXPECT_LT(pos_err(sol.q[i], kp.exact(te[i])), 1e-10) << te[i];
+  }
+  // sol(t) anywhere inside.
+  for (double t : {0.123, 1.0, 3.3, 6.2}) EXPECT_LT(pos_err(sol(t).q, kp.exact(t)), 1e-10) << t;
+  EXPECT_THROW(sol(7.0), invalid_input);
+}
+
+TEST(Solve, InvalidInputIsRefusedWithOneClearError) {
+  VdForce f = [](const Vd& q, Vd& a) { a = q; };
+  const SecondOrderProblem bad_sizes(f, Vd{1.0, 2.0}, Vd{1.0}, 0.0, 1.0);
+  EXPECT_THROW(solve(bad_sizes, "VV", {.steps = 10}), invalid_input);
+  const SecondOrderProblem nan_state(f, Vd{NAN}, Vd{1.0}, 0.0, 1.0);
+  EXPECT_THROW(solve(nan_state, "VV", {.steps = 10}), invalid_input);
+  const SecondOrderProblem inf_span(f, Vd{1.0}, Vd{1.0}, 0.0, INFINITY);
+  EXPECT_THROW(solve(inf_span, "VV", {.steps = 10}), invalid_input);
+  const auto prob = kepler(0.5, 0.0, 1.0);
+  EXPECT_THROW(solve(prob, "VV"), invalid_input);             // no step size
+  EXPECT_THROW(solve(prob, "DP12-adaptive"), invalid_input);  // no tolerance
+  EXPECT_THROW(solve(prob, "VV", {.steps = 10, .t_eval = {0.5, 0.2}}), invalid_input);
+  EXPECT_THROW(solve(prob, "VV", {.steps = 10, .t_eval = {2.0}}), invalid_input);
+  // Every one of these is a nystrom::error too.
+  EXPECT_THROW(solve(prob, "VV"), nystrom::error);
+  // An adaptive method through the fixed-step factory is refused, never run with fixed steps.
+  EXPECT_THROW(make_integrator<V2>(resolve_method("DP12-adaptive"), KeplerForce{}), invalid_input);
+  EXPECT_THROW(make_integrator<V2>(resolve_method("M12-adaptive"), KeplerForce{}), invalid_input);
+}
+
+TEST(Solve, AForceReturningNaNIsReportedWithTheTime) {
+  // a = NaN once q passes 0.5: the adaptive controllers must stop with an error, not loop.
+  VdForce f = [](const Vd& q, Vd& a) { a[0] = q[0] > 0.5 ? NAN : 1.0; };
+  const SecondOrderProblem prob(f, Vd{0.0}, Vd{0.0}, 0.0, 2.0);
+  for (const std::string m : {"DP12-adaptive", "M10-adaptive"}) {
+    SCOPED_TRACE(m);
+    try {
+      solve(prob, m, {.rtol = 1e-10});
+      ADD_FAILURE() << "no error";
+    } catch (const step_size_underflow& e) {
+      EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("t = 1"), std::string::npos) << e.what();  // q = t^2/2 = 0.5 at t = 1
+    }
+  }
+  try {
+    solve(prob, "VV", {.steps = 100});
+    ADD_FAILURE() << "no error";
+  } catch (const nystrom::error& e) {
+    EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SolveDense, InteriorErrorWithinTenTimesTheStepEndErrorUpToOrderEight) {
+  // Kepler e = 0.5 over one period, about 2000 forces per period for every method; the largest position
+  // error at 100 points inside each step against the largest error at the step ends.
+  const KeplerProblem<double> kp(0.5);
+  const double T = 2 * pi;
+  const auto prob = kepler(0.5, 0.0, T);
+  int tested = 0;
+  for (const auto& def : catalog()) {
+    if (def.info.adaptive || def.info.order <= 0) continue;
+    SCOPED_TRACE(def.info.name);
+    const long steps = std::max(20L, 2000L / std::max(1, def.info.forces_per_step));
+    const auto sol = solve(prob, def, {.steps = steps});
+    double end_err = 0, mid_err = 0;
+    for (std::size_t k = 0; k < sol.t.size(); ++k) end_err = std::max(end_err, pos_err(sol.q[k], kp.exact(sol.t[k])));
+    for (std::size_t k = 0; k + 1 < sol.t.size(); ++k)
+      for (int j = 1; j <= 100; ++j) {
+        const double t = sol.t[k] + (sol.t[k + 1] - sol.t[k]) * j / 101.0;
+        mid_err = std::max(mid_err, pos_err(sol(t).q, kp.exact(t)));
+      }
+    if (def.info.order <= 6) {
+      EXPECT_LE(mid_err, 10 * end_err) << "step ends " << end_err << ", inside " << mid_err;
+      ++tested;
+    } else {
+      // Order > 6: the quintic Hermite interpolant (order 6) limits sol(t) between step ends. Measured
+      // here (about 2000 forces per period): M8 2e-13 at the step ends, 1.3e-10 inside; KL8 1e-11 and
+      // 3e-9; RKNa14 4e-11 and 1e-9; M10-M16, SS10, DP10, DP12 1e-15..4e-13 and 1e-9..3e-7.
+      EXPECT_LT(mid_err, 1e-6);
+      std::printf("dense output %-10s order %2d: step ends %.2e, inside %.2e\n", def.info.name.c_str(), def.info.order,
+                  end_err, mid_err);
+    }
+  }
+  EXPECT_GT(tested, 15);
+}
+
+TEST(SolveEvents, KeplerPericentreAndApocentrePassagesAreTheAnalyticOnes) {
+  // From the apocentre, r.v < 0 until the pericentre at t = pi (mod 2 pi), where it turns positive.
+  const auto prob = kepler(0.5, 0.0, 6 * pi - 0.5);  // not ending on an apocentre (g = 0 there)
+  const std::vector<Event<V2>> ev = {
+      {"pericentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, +1, false},
+      {"apocentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, -1, false},
+  };
+  for (const std::string m : {"DP12-adaptive", "M14-adaptive", "GBS", "M8"}) {
+    SCOPED_TRACE(m);
+    // The adaptive steps are bounded (h_max) so that the dense output between them is accurate; GBS's
+    // steps (about 1 here) leave the quintic interpolant at 1e-3 in time.
+    SolveOptions o{.steps = 3000, .rtol = 1e-13};
+    o.adaptive.h_max = 0.02;
+    const auto sol = solve(prob, m, o, ev);
+    std::vector<double> peri, apo;
+    for (const auto& e : sol.events) (e.name == "pericentre" ? peri : apo).push_back(e.t);
+    ASSERT_EQ(peri.size(), 3u);
+    ASSERT_EQ(apo.size(), 2u);  // 2 pi and 4 pi
+    // The located times are those of the dense output (quintic Hermite between step ends): for the
+    // fixed-step M8 it is the method's accuracy, for the large steps of the adaptive methods the
+    // interpolant's.
+    const double tol = m == "M8" ? 1e-11 : m == "GBS" ? 1e-3 : 1e-8;
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(peri[i], (2 * i + 1) * pi, tol * (2 * i + 1) * pi);
+    for (int i = 0; i < 2; ++i) EXPECT_NEAR(apo[i], 2 * (i + 1) * pi, tol * 2 * (i + 1) * pi);
+    for (int i = 0; i < 3; ++i) std::printf("%s pericentre %d: t - (2i+1) pi = %.2e\n", m.c_str(), i, peri[i] - (2 * i + 1) * pi);
+  }
+}
+
+TEST(SolveEvents, TerminalEventEndsTheRunThere) {
+  const auto prob = kepler(0.9, 0.0, 20.0);
+  const std::vector<Event<V2>> ev = {
+      {"pericentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, +1, true}};
+  SolveOptions o{.rtol = 1e-13};
+  o.adaptive.h_max = 0.01;
+  const auto sol = solve(prob, "DP12-adaptive", o, ev);
+  EXPECT_EQ(sol.status, SolveStatus::terminated_by_event);
+  EXPECT_NEAR(sol.t_final, pi, 1e-7);
+  EXPECT_NEAR(sol.q_final[0], -0.1, 1e-7);  // the pericentre of e = 0.9 at (-(1 - e), 0)
+  EXPECT_NEAR(sol.q_final[1], 0.0, 1e-7);
+  EXPECT_EQ(sol.events.size(), 1u);
+  EXPECT_LE(sol.t.back(), sol.t_final);
+}
+
+TEST(SolveEvents, HenonHeilesPoincareSectionLiesOnTheSectionAndConservesEnergy) {
+  // H = (px^2 + py^2)/2 + (x^2 + y^2)/2 + x^2 y - y^3/3 at E = 1/8; section x = 0, px > 0.
+  VdForce f = [](const Vd& q, Vd& a) {
+    a[0] = -q[0] - 2 * q[0] * q[1];
+    a[1] = -q[1] - q[0] * q[0] + q[1] * q[1];
+  };
+  auto energy = [](const Vd& q, const Vd& p) {
+    return (p[0] * p[0] + p[1] * p[1]) / 2 + (q[0] * q[0] + q[1] * q[1]) / 2 + q[0] * q[0] * q[1] -
+           q[1] * q[1] * q[1] / 3;
+  };
+  const double E = 0.125, y0 = 0.1, py0 = 0.2;
+  const double px0 = std::sqrt(2 * E - py0 * py0 - y0 * y0 + 2 * y0 * y0 * y0 / 3);
+  const SecondOrderProblem prob(f, Vd{0.0, y0}, Vd{px0, py0}, 0.0, 200.0);
+  const std::vector<Event<Vd>> ev = {{"x=0", [](double, const Vd& q, const Vd&) { return q[0]; }, +1, false}};
+  const auto sol = solve(prob, "M8", {.steps = 20000}, ev);
+  ASSERT_GT(sol.events.size(), 20u);
+  for (const auto& e : sol.events) {
+    EXPECT_LT(std::abs(e.q[0]), 1e-12);
+    EXPECT_GT(e.v[0], 0.0);
+    EXPECT_NEAR(energy(e.q, e.v), E, 1e-10);
+  }
+}
+
+TEST(SolveCheckpoint, RestartIsBitwiseTheUninterruptedRun) {
+  const auto prob = kepler(0.7, 0.0, 30.0);
+  struct Case {
+    std::string method;
+    SolveOptions opt;
+  };
+  std::vector<Case> cases = {{"M8", {.steps = 3000}},  // compensated summation (double's default)
+                             {"KL8", {.h = 0.011}},
+                             {"DP12-adaptive", {.rtol = 1e-11}},
+                             {"M12-adaptive", {.rtol = 1e-11}},
+                             {"GBS", {.rtol = 1e-11}}};
+  for (auto& c : cases) {
+    SCOPED_TRACE(c.method);
+    const auto def = resolve_solve_method(c.method);
+    const auto plain = solve(prob, def, c.opt);
+    c.opt.checkpoint_at = 12.3;
+    c.opt.checkpoint_problem = "kepler e=0.7";
+    std::string text;
+    c.opt.on_checkpoint = [&](const std::string& s) { text = s; };
+    const auto first = solve(prob, def, c.opt);
+    ASSERT_TRUE(first.checkpoint.has_value());
+    EXPECT_GE(first.checkpoint->t, 12.3);
+    EXPECT_EQ(to_text(*first.checkpoint), text);
+    // Taking the checkpoint changes nothing.
+    EXPECT_EQ(first.q_final, plain.q_final);
+    EXPECT_EQ(first.v_final, plain.v_final);
+    EXPECT_EQ(first.force_evals, plain.force_evals);
+    // Restart from the text: bitwise the same end.
+    const auto cp = checkpoint_from_text<double>(text);
+    const auto second = resume(prob, def, cp, c.opt);
+    EXPECT_EQ(second.q_final, plain.q_final);
+    EXPECT_EQ(second.v_final, plain.v_final);
+    EXPECT_EQ(second.accepted, plain.accepted);
+    EXPECT_NEAR(static_cast<double>(second.force_evals), static_cast<double>(plain.force_evals), 1.0);
+    // Another method or problem is refused.
+    EXPECT_THROW(resume(prob, resolve_method("M6"), cp, c.opt), invalid_input);
+    SolveOptions other = c.opt;
+    other.checkpoint_problem = "kepler e=0.5";
+    EXPECT_THROW(resume(prob, def, cp, other), invalid_input);
+  }
+  EXPECT_THROW(checkpoint_from_text<double>("nystrom-checkpoint 99\n"), invalid_input);
+  EXPECT_THROW(checkpoint_from_text<double>("garbage"), invalid_input);
+}
