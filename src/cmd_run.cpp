@@ -7,11 +7,13 @@
 #include "cli.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "runner.hpp"
+#include "runner_solve.hpp"
 
 namespace {
 
 struct Options {
   nystrom::cli::RunRequest req;
+  nystrom::cli::SolveRequest sreq;
   std::string method;
   bool json = false;
 };
@@ -34,9 +36,22 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--precision", o->req.precision, "Scalar type (double, long-double, ...)")->capture_default_str();
   app.add_option("--tol", o->req.tol, "Tolerance of an adaptive method (e.g. DP12-adaptive)");
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
+  app.add_option("--output-times", o->sreq.output_times,
+                 "Kepler: A:B:N, the state at N equally spaced times from A to B (dense output; JSON `output`)");
+  app.add_option("--events", o->sreq.events, "Kepler: events to locate, any of pericentre,apocentre,y=0 (JSON `events`)");
+  app.add_option("--checkpoint", o->sreq.checkpoint, "Kepler: write the integrator's state to this file ...");
+  app.add_option("--checkpoint-at", o->sreq.checkpoint_at, "... at the first step boundary at or after this time");
+  app.add_option("--restart", o->sreq.restart, "Kepler: continue from a checkpoint file (the other options must match)");
   app.add_flag("--json", o->json, "Print one JSON object");
   return [o]() {
     const auto def = nystrom::cli::resolve_run_method(o->method);
+    if (o->sreq.any()) {
+      const auto r = nystrom::cli::run_kepler_solve(o->req, o->sreq, def);
+      auto j = r.report.to_json();
+      for (const auto& [k, v] : r.extra.items()) j[k] = v;
+      std::cout << j.dump(2) << "\n";  // with or without --json: output times and events do not fit the table
+      return 0;
+    }
     const auto r = nystrom::cli::run_case(o->req, def);
     if (o->json) {
       std::cout << r.to_json().dump(2) << "\n";

@@ -1,0 +1,191 @@
+// `nystrom run --problem kepler` through solve(): output times from the dense output, events,
+// checkpoint and restart (double precision).
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "nystrom/problems/kepler.hpp"
+#include "nystrom/solve.hpp"
+#include "runner_solve.hpp"
+
+namespace nystrom::cli {
+
+namespace {
+
+using V2 = std::array<double, 2>;
+
+double parse_number(const std::string& text, const std::string& what) {
+  std::size_t pos = 0;
+  double x = 0;
+  try {
+    x = std::stod(text, &pos);
+  } catch (const std::exception&) {
+    pos = 0;
+  }
+  if (pos == 0 || pos != text.size() || !std::isfinite(x)) throw UsageError(what + ": '" + text + "' is not a finite number");
+  return x;
+}
+
+// "A:B:N" -> N equally spaced times from A to B.
+std::vector<double> parse_output_times(const std::string& spec) {
+  const auto a = spec.find(':');
+  const auto b = a == std::string::npos ? a : spec.find(':', a + 1);
+  if (b == std::string::npos || spec.find(':', b + 1) != std::string::npos)
+    throw UsageError("--output-times must be A:B:N (from A to B, N points)");
+  const double t0 = parse_number(spec.substr(0, a), "--output-times");
+  const double t1 = parse_number(spec.substr(a + 1, b - a - 1), "--output-times");
+  const std::string ns = spec.substr(b + 1);
+  long n = 0;
+  std::size_t pos = 0;
+  try {
+    n = std::stol(ns, &pos);
+  } catch (const std::exception&) {
+    pos = 0;
+  }
+  if (pos == 0 || pos != ns.size() || n < 1 || n > 10000000)
+    throw UsageError("--output-times: N must be an integer between 1 and 10000000");
+  if (n == 1 && t0 != t1) throw UsageError("--output-times: one point needs A = B");
+  if (t1 < t0) throw UsageError("--output-times: B must not be before A");
+  std::vector<double> t(static_cast<std::size_t>(n));
+  for (long i = 0; i < n; ++i) t[static_cast<std::size_t>(i)] = n == 1 ? t0 : t0 + (t1 - t0) * static_cast<double>(i) / static_cast<double>(n - 1);
+  if (n > 1) t.back() = t1;
+  return t;
+}
+
+std::vector<Event<V2>> parse_events(const std::string& spec) {
+  std::vector<Event<V2>> ev;
+  std::stringstream ss(spec);
+  std::string name;
+  auto radial = [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; };
+  while (std::getline(ss, name, ',')) {
+    if (name == "pericentre" || name == "pericenter")
+      ev.push_back({"pericentre", radial, +1, false});  // r.v turns from negative to positive
+    else if (name == "apocentre" || name == "apocenter")
+      ev.push_back({"apocentre", radial, -1, false});
+    else if (name == "y=0")
+      ev.push_back({"y=0", [](double, const V2& q, const V2&) { return q[1]; }, 0, false});
+    else
+      throw UsageError("unknown event '" + name + "' (known: pericentre, apocentre, y=0)");
+  }
+  if (ev.empty()) throw UsageError("--events: no event given (known: pericentre, apocentre, y=0)");
+  return ev;
+}
+
+nlohmann::json vec(const V2& x) { return nlohmann::json::array({x[0], x[1]}); }
+
+}  // namespace
+
+SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq, const MethodDef& def) {
+  if (req.problem != "kepler")
+    throw UsageError("--output-times, --events, --checkpoint and --restart run on the kepler problem");
+  if (req.steps_per_period <= 0) throw UsageError("--steps-per-period must be a positive integer");
+  if (req.periods <= 0) throw UsageError("--periods must be a positive integer");
+  if (req.steps_per_period > 1'000'000'000L / req.periods)
+    throw UsageError("too many steps requested (steps-per-period x periods must be at most 1e9)");
+  if (def.info.adaptive && !(req.tol > 0 && std::isfinite(req.tol)))
+    throw UsageError("method '" + def.info.name + "' is adaptive: give a positive --tol");
+  if (!def.info.adaptive && req.tol != 0)
+    throw UsageError("--tol applies to adaptive methods only; '" + def.info.name + "' runs with fixed steps");
+  if (req.precision != "double")
+    throw UsageError("--output-times, --events, --checkpoint and --restart run in double precision");
+  if (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1)
+    throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
+  if (sreq.checkpoint.empty() != std::isnan(sreq.checkpoint_at))
+    throw UsageError("--checkpoint FILE and --checkpoint-at T go together");
+  if (!sreq.checkpoint.empty() && !sreq.restart.empty() && sreq.checkpoint == sreq.restart)
+    throw UsageError("--checkpoint and --restart name the same file");
+  const KeplerProblem<double> kp(req.ecc);
+  const auto s0 = kp.initial_state();
+  const double t_end = KeplerProblem<double>::period() * static_cast<double>(req.periods);
+  const SecondOrderProblem prob(KeplerForce{}, s0.q, s0.v, 0.0, t_end);
+  const bool tolerance = def.info.adaptive;
+  SolveOptions opt;
+  if (tolerance)
+    opt.rtol = req.tol;
+  else
+    opt.steps = req.steps_per_period * req.periods;
+  opt.engine.keep_complex = req.keep_complex;
+  opt.dense = false;  // the output times and events use the step ends' interpolants as they go
+  if (!sreq.output_times.empty()) opt.t_eval = parse_output_times(sreq.output_times);
+  for (double t : opt.t_eval)
+    if (t < 0 || t > t_end)
+      throw UsageError("--output-times: every time must lie in the integrated span [0, " + std::to_string(t_end) + "]");
+  const auto events = sreq.events.empty() ? std::vector<Event<V2>>{} : parse_events(sreq.events);
+  // What a checkpoint must match: everything that defines the steps, except the end of the span.
+  char tag[256];
+  std::snprintf(tag, sizeof tag, "kepler ecc=%a precision=double %s=%a keep_complex=%d", req.ecc,
+                tolerance ? "tol" : "steps_per_period", tolerance ? req.tol : static_cast<double>(req.steps_per_period),
+                req.keep_complex ? 1 : 0);
+  opt.checkpoint_problem = tag;
+  if (!sreq.checkpoint.empty()) {
+    if (!(sreq.checkpoint_at >= 0) || !std::isfinite(sreq.checkpoint_at))
+      throw UsageError("--checkpoint-at must be a finite time >= 0");
+    opt.checkpoint_at = sreq.checkpoint_at;
+    const std::string file = sreq.checkpoint;
+    opt.on_checkpoint = [file](const std::string& text) { write_checkpoint_text(file, text); };
+  }
+  const auto w0 = std::chrono::steady_clock::now();
+  Solution<V2> sol;
+  try {
+    if (sreq.restart.empty()) {
+      sol = solve(prob, def, opt, events);
+    } else {
+      const auto cp = read_checkpoint<double>(sreq.restart);
+      if (cp.t > t_end) throw UsageError("the checkpoint lies after the end of the span");
+      sol = resume(prob, def, cp, opt, events);
+    }
+  } catch (const invalid_input& e) {
+    throw UsageError(e.what());
+  }
+  const auto w1 = std::chrono::steady_clock::now();
+  if (!sreq.checkpoint.empty() && !sol.checkpoint)
+    throw UsageError("--checkpoint-at lies at or after the end of the run: no checkpoint was written");
+
+  SolveRunResult result;
+  RunReport& r = result.report;
+  auto& extra = result.extra;
+  r.method = def.info.name;
+  r.family = def.info.family;
+  r.order = def.info.order;
+  r.problem = req.problem;
+  r.precision = req.precision;
+  r.ecc = req.ecc;
+  r.steps = sol.accepted;
+  r.force_evals = sol.force_evals;
+  r.h = tolerance ? t_end / static_cast<double>(sol.accepted > 0 ? sol.accepted : 1)
+                  : KeplerProblem<double>::period() / static_cast<double>(req.steps_per_period);
+  r.seconds = std::chrono::duration<double>(w1 - w0).count();
+  State<V2> s{sol.q_final, sol.v_final};
+  r.precession_per_period = signed_angle(lrl_vector(s0), lrl_vector(s)) / static_cast<double>(req.periods);
+  const double e0 = kepler_energy(s0);
+  r.energy_error = std::abs((kepler_energy(s) - e0) / e0);
+  const auto ex = kp.exact(t_end);
+  r.position_error = std::hypot(s.q[0] - ex.q[0], s.q[1] - ex.q[1]);
+  // The final state exactly (the shortest decimal that reads back to the same double: a comparison of
+  // two runs' q and v is a bitwise one).
+  extra["t"] = sol.t_final;
+  extra["q"] = vec(sol.q_final);
+  extra["v"] = vec(sol.v_final);
+  extra["output_force_evals"] = sol.output_force_evals;
+  extra["rejected"] = sol.rejected;
+  if (!sreq.output_times.empty()) {
+    auto out = nlohmann::json::array();
+    for (std::size_t i = 0; i < sol.t.size(); ++i)
+      out.push_back({{"t", sol.t[i]}, {"q", vec(sol.q[i])}, {"v", vec(sol.v[i])}});
+    extra["output"] = out;
+  }
+  if (!events.empty()) {
+    auto out = nlohmann::json::array();
+    for (const auto& e : sol.events) out.push_back({{"name", e.name}, {"t", e.t}, {"q", vec(e.q)}, {"v", vec(e.v)}});
+    extra["events"] = out;
+  }
+  if (sol.checkpoint) extra["checkpoint_t"] = sol.checkpoint->t;
+  return result;
+}
+
+}  // namespace nystrom::cli

@@ -1,0 +1,148 @@
+// The command-line contract of `run` through solve(): --output-times (dense output), --events, and
+// --checkpoint/--restart (bitwise the same end). The tool is found through NYSTROM_BIN (set by CTest).
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "nystrom/problems/kepler.hpp"
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string tool() {
+  const char* b = std::getenv("NYSTROM_BIN");
+  return b ? b : "nystrom";
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::filesystem::path temp_dir() {
+  auto d = std::filesystem::temp_directory_path() /
+           ("nystrom-cli-solve-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+Result run(const std::string& args) {
+  const auto dir = temp_dir();
+  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = tool() + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+constexpr double pi = std::numbers::pi;
+
+}  // namespace
+
+TEST(CliSolve, OutputTimesComeFromTheDenseOutput) {
+  const auto r = run(
+      "run --problem kepler --ecc 0.5 --method M8 --steps-per-period 200 --periods 2 --output-times 0:12.566:201 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& out = j.at("output");
+  ASSERT_EQ(out.size(), 201u);
+  EXPECT_EQ(out[0]["t"].get<double>(), 0.0);
+  EXPECT_EQ(out[200]["t"].get<double>(), 12.566);
+  const nystrom::KeplerProblem<double> kp(0.5);
+  double worst = 0;
+  for (const auto& p : out) {
+    const double t = p["t"].get<double>();
+    const auto ex = kp.exact(t);
+    worst = std::max(worst, std::hypot(p["q"][0].get<double>() - ex.q[0], p["q"][1].get<double>() - ex.q[1]));
+    EXPECT_NEAR(p["v"][0].get<double>(), ex.v[0], 1e-6);
+  }
+  EXPECT_LT(worst, 1e-7);  // M8 at 200 steps per period: the step-end error is about 1e-9
+  EXPECT_EQ(j.at("q").size(), 2u);
+}
+
+TEST(CliSolve, PericentreApocentreAndAxisCrossingEvents) {
+  const auto r = run("run --problem kepler --ecc 0.9 --method DP12-adaptive --tol 1e-12 --periods 3 --events "
+                     "pericentre,apocentre,y=0 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  std::vector<double> peri, apo, axis;
+  for (const auto& e : j.at("events")) {
+    const std::string n = e["name"];
+    (n == "pericentre" ? peri : n == "apocentre" ? apo : axis).push_back(e["t"].get<double>());
+    ASSERT_EQ(e["q"].size(), 2u);
+    ASSERT_EQ(e["v"].size(), 2u);
+  }
+  ASSERT_EQ(peri.size(), 3u);
+  // The event times come from the dense output between the adaptive steps (quintic Hermite).
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(peri[i], (2 * i + 1) * pi, 1e-4);
+  // 2 pi and 4 pi; 6 pi is the end of the span, where r.v = 0 up to rounding (found or not).
+  ASSERT_GE(apo.size(), 2u);
+  ASSERT_LE(apo.size(), 3u);
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(apo[i], 2 * (i + 1) * pi, 1e-4);
+  // The x axis is crossed at every pericentre and apocentre.
+  EXPECT_GE(axis.size(), 5u);
+  EXPECT_LE(axis.size(), 6u);
+  const auto only = run("run --problem kepler --ecc 0.9 --method DP12-adaptive --tol 1e-12 --periods 3 --events "
+                        "pericentre --json");
+  ASSERT_EQ(only.code, 0) << only.err;
+  EXPECT_EQ(nlohmann::json::parse(only.out).at("events").size(), 3u);
+}
+
+TEST(CliSolve, RestartFromACheckpointEndsInBitwiseTheSameState) {
+  const auto dir = temp_dir();
+  for (const std::string m : {"--method M8 --steps-per-period 100", "--method DP12-adaptive --tol 1e-10",
+                              "--method M12-adaptive --tol 1e-10", "--method GBS --tol 1e-10"}) {
+    SCOPED_TRACE(m);
+    const auto f = (dir / "state.ckpt").string();
+    std::filesystem::remove(f);
+    const std::string base = "run --problem kepler --ecc 0.6 " + m + " --periods 20 --json";
+    const auto a = run(base + " --checkpoint " + f + " --checkpoint-at 31.4");
+    ASSERT_EQ(a.code, 0) << a.err;
+    ASSERT_TRUE(std::filesystem::exists(f));
+    EXPECT_FALSE(std::filesystem::exists(f + ".tmp"));
+    const auto b = run(base + " --restart " + f);
+    ASSERT_EQ(b.code, 0) << b.err;
+    const auto ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out);
+    EXPECT_GE(ja.at("checkpoint_t").get<double>(), 31.4);
+    for (const char* k : {"q", "v"})
+      for (int i = 0; i < 2; ++i) EXPECT_EQ(ja.at(k)[i].get<double>(), jb.at(k)[i].get<double>()) << k << i;
+    EXPECT_EQ(ja.at("steps"), jb.at("steps"));
+    // Another method, eccentricity or step count is refused with one clear error.
+    const auto other = run("run --problem kepler --ecc 0.5 " + m + " --periods 20 --restart " + f);
+    EXPECT_EQ(other.code, 2);
+    EXPECT_NE(other.err.find("nystrom: error: "), std::string::npos) << other.err;
+  }
+  const auto missing = run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --restart " + (dir / "none").string());
+  EXPECT_EQ(missing.code, 2);
+  std::ofstream(dir / "bad.ckpt") << "not a checkpoint\n";
+  const auto bad = run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --restart " + (dir / "bad.ckpt").string());
+  EXPECT_EQ(bad.code, 2);
+  const auto half = run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --checkpoint-at 3");
+  EXPECT_EQ(half.code, 2);
+  const auto times = run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --output-times 0:100:5");
+  EXPECT_EQ(times.code, 2);
+  const auto ev = run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --events perihelion");
+  EXPECT_EQ(ev.code, 2);
+  std::filesystem::remove_all(dir);
+}
