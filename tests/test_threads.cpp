@@ -38,7 +38,8 @@ void append(std::vector<bigfloat>& out, const SplittingScheme<bigcomplex>& s) {
   for (const auto& st : s.steps) append(out, st.coef);
 }
 
-// Every coefficient of a method, in a fixed order; a multi-product method's sequence {k_i} is checked apart.
+// Every coefficient of a method, in a fixed order (of a multi-product method, its base: the sequence {k_i} is
+// integers).
 // (Copies keep the precision of their source; a bigfloat made from a number here, outside any BigPrecision,
 // would take whatever default precision another thread's guard has set.)
 std::vector<bigfloat> coefficients(const MethodData& data) {

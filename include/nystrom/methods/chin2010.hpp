@@ -1,9 +1,9 @@
 // The methods of S. A. Chin, "Multi-product splitting and Runge-Kutta-Nyström integrators",
-// Celest. Mech. Dyn. Astron. 106 (2010) 391-406 (shared/papers/000_...):
+// Celest. Mech. Dyn. Astron. 106 (2010) 391-406:
 //   * velocity and position Verlet (eqs 25, 26), Forest-Ruth (position-first form compared in Fig 1);
 //   * the force-consolidated RKN methods as tableaux: Nyström 4 (eqs 28, 32), M4 (eqs 33-34),
 //     the new 5-force sixth-order method (eqs 39-47), Albrecht's A6 (eqs 61-62);
-//   * the forward fourth-order integrator A' (Fig 1; shared/NOTES.md, after Chin 2007 and Omelyan 2006);
+//   * the forward fourth-order integrator A' (Fig 1; after Chin 2007 and Omelyan 2006);
 //   * the multi-product integrators M4 ... M16 (natural sequence, PV base) of eq (17).
 // Tableau rows below are transcribed from the cited equations; the derivation is in the comments.
 #pragma once

@@ -1,6 +1,6 @@
 // The fifth-order RKN splittings of M. A. Gürkan, "Fifth order Runge-Kutta-Nyström methods with
 // complex coefficients" (preprint, Leiden/Sabanci, 2012; the author's repository
-// atakan/Complex_Coeff_RKN gives it as submitted to Math. Comp.; shared/papers/002_...), and the
+// atakan/Complex_Coeff_RKN gives it as submitted to Math. Comp.), and the
 // complex third-order method of J. E. Chambers, "Symplectic integrators with complex time steps",
 // Astron. J. 126 (2003) 1119, which that paper compares (its ref. [11]).
 //
