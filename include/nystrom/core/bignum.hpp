@@ -48,10 +48,10 @@ inline unsigned reference_bits(long working_bits) { return static_cast<unsigned>
 /// Sets the MPFR default precision of bigfloat (in bits) for the lifetime of the guard.
 ///
 /// Boost 1.74 keeps that precision in one process-wide variable (a function-local static of
-/// mpfr_float_backend<0>, not thread_local), and every bigfloat created or computed reads it. Two threads
-/// building coefficients at different precisions would race on it: one thread's coefficients could be
-/// rounded at the other's precision, and interleaved save/restore pairs could leave the wrong default
-/// behind. The guard therefore also holds a process-wide recursive mutex for its lifetime: a guard in
+/// mpfr_float_backend<0>, atomic but not thread_local), and every bigfloat created or computed reads it.
+/// Two threads building coefficients at different precisions would race on it (a race of logic, not a data
+/// race, so ThreadSanitizer is silent about it): one thread's coefficients could be rounded at the other's
+/// precision, and interleaved save/restore pairs could leave the wrong default behind. The guard therefore also holds a process-wide recursive mutex for its lifetime: a guard in
 /// another thread waits until this one ends, and guards nested in one thread nest as before. Coefficients
 /// are built once per integrator, outside the hot loop, so serialising their construction costs no speed
 /// where it matters. In a multi-threaded program, compute with bigfloat only inside a guard.
