@@ -11,7 +11,7 @@
 //             10 forces
 // The MPE engine runs its products in lockstep (the default for fixed-size states); it is also measured
 // with them in sequence ("sequential", as in the hand-written loops). The summary gives the cost of an M8
-// step relative to 10 sequential force evaluations (10 hand VV steps): issue 8's target is <= 0.5.
+// step relative to 10 sequential force evaluations (10 hand VV steps); the target is <= 0.5.
 //
 // One benchmark iteration integrates a batch of kSteps steps from the apocentre (h = 2 pi / kSteps, one
 // period per batch), the state reset every iteration (both variants then evaluate the first force anew).

@@ -14,13 +14,14 @@
 // Before benchmarking, every precision's final state after one period is checked against double's
 // (same method and step, so they must agree to double's rounding). After the run, a table gives the
 // CPU time per step (minimum over repetitions, robust on a shared machine) and the ratio to double.
-// Target (the issue): double-double at most 10x double per step. Double-double multiplication needs
+// Target: double-double at most 10x double per step. Double-double multiplication needs
 // an exact product a*b = p + e: with hardware FMA (built with -march=native, CMake option
 // NYSTROM_NATIVE) that is two instructions, without it Dekker's splitting (17 flops); the summary says
 // which one this build uses. In dd and qd the force's 1/r^3 comes from inv_r3 (core/extended.hpp: a
 // double seed and one correction, no libqd square root or division), and dd's products are forced
-// inline (the out-of-line calls cost a fifth of a step). Measured on 2 shared cores (minimum over 5
-// repetitions, two runs), default build: dd 14.8x double before these changes, 8.0-9.6x after.
+// inline (the out-of-line calls cost a fifth of a step). Measured (minimum over 5 repetitions, two
+// runs, default build): dd 8.0-9.6x double; 14.8x with libqd's own square root, division and
+// out-of-line products.
 //
 //   bench_precision --benchmark_repetitions=5     (the default here: 5 repetitions, 0.2 s each)
 #include <benchmark/benchmark.h>

@@ -115,7 +115,7 @@ void write_report(const Options& o) {
         "which the test suite asserts from `reproduce all --quick`.\n\n"
      << "Papers: S. A. Chin, *Multi-product splitting and Runge-Kutta-Nystrom integrators*, Celest. Mech. Dyn. "
         "Astron. 106 (2010) 391; M. A. Gurkan, *Fifth order Runge-Kutta-Nystrom methods with complex "
-        "coefficients*.\n\n";
+        "coefficients*, preprint (2012).\n\n";
   md << "| target | run | seconds | claims holding as published | in words |\n|---|---|---|---|---|\n";
   double total = 0;
   for (const auto& r : results) {

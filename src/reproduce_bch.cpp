@@ -1,5 +1,5 @@
 // Table 4.3 of M. A. Gurkan, "Fifth order Runge-Kutta-Nystrom methods with complex coefficients"
-// (shared/papers/002_...), recomputed by `nystrom reproduce gurkan-table4.3`: the degree-6 coefficients X11, X16, X17,
+// (preprint, 2012), recomputed by `nystrom reproduce gurkan-table4.3`: the degree-6 coefficients X11, X16, X17,
 // X19, X20 of H - Z in Gurkan's Philip Hall basis of the RKN Lie algebra, and their norm (sum |X_i|^2)^(1/2), for the
 // nine methods of Tables 4.1 and 4.2, computed from the catalog's coefficients with the library's BCH analysis
 // (include/nystrom/analysis/bch.hpp, the same as `nystrom bch --gurkan-table`) and compared digit by digit with the

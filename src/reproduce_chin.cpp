@@ -1,5 +1,5 @@
 // The figures of S. A. Chin, "Multi-product splitting and Runge-Kutta-Nystrom integrators",
-// Celest. Mech. Dyn. Astron. 106 (2010) 391 (shared/papers/000_...), recomputed by `nystrom reproduce`:
+// Celest. Mech. Dyn. Astron. 106 (2010) 391, recomputed by `nystrom reproduce`:
 //   chin-fig1  precession error coefficient e_P = dtheta / h^4 against eccentricity, FR, N, A', M4;
 //   chin-fig2  precession error against force evaluations N at e = 0.9, sixth-order methods;
 //   chin-fig3  the same for KL8, SS10, DP10, DP12 and the minimal MPE integrators M4 ... M16, with the envelope.
@@ -151,7 +151,7 @@ TargetResult fig1(const Context& ctx) {
                   }(),
                   n_final),
       "The plot shows |e_P| on a logarithmic axis; the legend gives the sign. FR is the position-first Forest-Ruth "
-      "form, A' the forward algorithm with the force at a shifted position (shared/NOTES.md).",
+      "form, A' the forward algorithm 4A with its force gradient replaced by a force at a shifted position.",
       "Long double suffices: at n = 5000 the smallest precession measured (e = 0.4) is ~1e-11 rad, far above the "
       "~1e-16 rounding error of a period in long double."};
 
@@ -284,7 +284,8 @@ TargetResult fig2(const Context& ctx) {
   res.files.push_back(res.name + ".png");
   res.interpretation = {
       "N = force evaluations spent on one orbital period; a method with f forces per step runs round(N/f) steps per "
-      "period (h = 2 pi f/N), for one period (shared/NOTES.md). The error is |dtheta|, the rotation of the "
+      "period (h = 2 pi f/N), for one period (the paper does not define N; this reading is ours). The error is "
+      "|dtheta|, the rotation of the "
       "Laplace-Runge-Lenz vector over that period.",
       "Quadruple precision: " + ctx.quad +
           (ctx.quad == "dd"

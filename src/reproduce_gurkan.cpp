@@ -1,5 +1,5 @@
 // The figures and the table of M. A. Gurkan, "Fifth order Runge-Kutta-Nystrom methods with complex
-// coefficients" (shared/papers/002_...), sec. 5, recomputed by `nystrom reproduce`:
+// coefficients" (preprint, 2012), sec. 5, recomputed by `nystrom reproduce`:
 //   gurkan-fig5.1    interquartile range of the local position error against h, two-body problem, e = 0.2;
 //   gurkan-fig5.2    the same for the 400-body Plummer sphere;
 //   gurkan-table5.1  CPU time per step normalised to the leapfrog, 10 000 bodies;

@@ -87,7 +87,7 @@ RunOut run_ld(const MethodDef& def, F force, const State<V2>& s0, LD T, long n, 
 
 double dist(const V2& a, const V2& b) { return static_cast<double>(std::hypot(a[0] - b[0], a[1] - b[1])); }
 
-// Kepler at a final time that is not a multiple of the period (NOTES.md): 1.37 periods.
+// Kepler at a final time that is not a multiple of the period (see test_order.cpp): 1.37 periods.
 constexpr LD kPeriods = 1.37L;
 
 double kepler_error(const MethodDef& def, double e, long n, EngineOptions opt = {}, double* imag = nullptr) {
@@ -472,7 +472,7 @@ TEST(ObservedOrder, KeplerCompositionsAndBlanesMoan) {
 
 TEST(ObservedOrder, RealGurkanMethodsAreFifthOrder) {
   // On Kepler (e = 0.5, 1.37 periods) the real fifth-order methods converge with slope 6: the
-  // fifth-order error term does not show on the two-body problem (as NOTES.md records for BR1 at
+  // fifth-order error term does not show on the two-body problem (as observed for BR1 at
   // whole periods; it stays hidden at this final time too). On Hénon-Heiles, a problem without that
   // structure, the fifth order appears once h is small enough.
   for (const auto& name : kGurkanReal) {

@@ -112,7 +112,7 @@ TEST(DormandPrince1987, CatalogEntries) {
   EXPECT_FALSE(t.fsal());  // the last stage (c = 1) is not at the 12th-order q_{n+1}
 }
 
-// Fixed-step convergence on Kepler (e = 0.5) at t = 4, not a whole period (NOTES.md).
+// Fixed-step convergence on Kepler (e = 0.5) at t = 4, not a whole period (see test_order.cpp).
 TEST(DormandPrince1987, FixedStepConvergenceRates) {
   using T = long double;
   using V = std::array<T, 2>;

@@ -6,7 +6,7 @@
 // Measurement (measure_order<T>: the real type T is a template parameter):
 //   * planar Kepler (Chin eqs 35-36), e = 0.5, from the apocentre to t_end = 2.5, i.e. 0.4 of an orbit,
 //     on the way in towards the pericentre (reached at t = pi). Short on purpose, and not a multiple
-//     of the period (at whole periods the Kepler error can look one order higher, shared/NOTES.md).
+//     of the period (at whole periods the Kepler error can look one order higher, e.g. BR1 at e = 0.2).
 //     Over longer times the error grows secularly (~ t h^(p+1)) while part of the order-p error stays
 //     bounded, so the asymptotic range moves to ever smaller errors. Measured, long double, e = 0.3:
 //     Gurkan's real fifth-order AR1 shows a slope of 5.99 from 1e-6 down to 1e-13 at t = 5 and 7

@@ -10,9 +10,9 @@
 //      in a forward-mode dual-number scalar type defined here (value + gradient over the 4 phase-space
 //      coordinates). The check must hold for methods declared symplectic and fail, by far, for the
 //      non-symplectic RKN methods (N4, M4, ...). Two problems: Kepler, and Henon-Heiles, whose force is
-//      not central (on Kepler Chin's A' is symplectic, see HenonHeilesForce). That the engines run unchanged on this type shows they
-//      are generic in the scalar type; the value part is checked to be bit-identical to long double,
-//      and the derivative part against finite differences.
+//      not central (on Kepler Chin's A' is symplectic, see HenonHeilesForce). That the engines run
+//      unchanged on this type shows they are generic in the scalar type; the value part is checked to be
+//      bit-identical to long double, and the derivative part against finite differences.
 //
 // Both loops read nystrom::catalog() at run time. Adaptive methods are skipped (they step with
 // their own controller). Complex-coefficient methods run (a) with complex state, imaginary parts

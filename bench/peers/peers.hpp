@@ -524,7 +524,7 @@ inline std::vector<PeerRun> sweep_method(const MethodSpec& m, double ecc, const 
   // Stop once the error has reached the floor, or has not improved on its best for 1.5 decades of
   // tolerance (adaptive) or two octaves of steps (fixed step), at least three runs, while already
   // small: the round-off plateau, on which errors scatter by 10x between neighbouring runs (a shorter
-  // rule stopped odeint's rkf78 at e = 0.5 before its 1448 steps/period run, 2.2e-13).
+  // rule would stop odeint's rkf78 at e = 0.5 before its 1448 steps/period run, 2.2e-13).
   double best = std::numeric_limits<double>::infinity();
   int stale = 0;
   const int stale_max = std::max(3, static_cast<int>(std::lround(m.adaptive ? 1.5 / std::log10(cfg.tol_ratio)

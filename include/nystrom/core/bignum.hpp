@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <complex>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -44,18 +45,33 @@ struct bigcomplex {
 /// Bits of the reference precision used to build coefficients for a working type of `bits`.
 inline unsigned reference_bits(long working_bits) { return static_cast<unsigned>(std::max<long>(256, working_bits + 64)); }
 
-/// Sets the MPFR default precision (in bits; a process-wide setting in Boost 1.74) for the lifetime of the guard.
+/// Sets the MPFR default precision of bigfloat (in bits) for the lifetime of the guard.
+///
+/// Boost 1.74 keeps that precision in one process-wide variable (a function-local static of
+/// mpfr_float_backend<0>, atomic but not thread_local), and every bigfloat created or computed reads it.
+/// Two threads building coefficients at different precisions would race on it (a race of logic, not a data
+/// race, so ThreadSanitizer is silent about it): one thread's coefficients could be rounded at the other's
+/// precision, and interleaved save/restore pairs could leave the wrong default behind. The guard therefore also holds a process-wide recursive mutex for its lifetime: a guard in
+/// another thread waits until this one ends, and guards nested in one thread nest as before. Coefficients
+/// are built once per integrator, outside the hot loop, so serialising their construction costs no speed
+/// where it matters. In a multi-threaded program, compute with bigfloat only inside a guard.
 class BigPrecision {
  public:
-  explicit BigPrecision(unsigned bits) : saved_(bigfloat::default_precision()) {
+  explicit BigPrecision(unsigned bits) : lock_(mutex()), saved_(bigfloat::default_precision()) {
     bigfloat::default_precision(bits_to_digits10(bits));
   }
-  ~BigPrecision() { bigfloat::default_precision(saved_); }
+  ~BigPrecision() { bigfloat::default_precision(saved_); }  // lock_ is released after the restore
   BigPrecision(const BigPrecision&) = delete;
   BigPrecision& operator=(const BigPrecision&) = delete;
   static unsigned bits_to_digits10(unsigned bits) { return bits * 30103u / 100000u + 2u; }
 
  private:
+  // One mutex per process: a function-local static of an inline function is shared by all translation units.
+  static std::recursive_mutex& mutex() {
+    static std::recursive_mutex m;
+    return m;
+  }
+  std::unique_lock<std::recursive_mutex> lock_;  // declared first: taken before saved_ is read
   unsigned saved_;
 };
 

@@ -100,7 +100,7 @@ void split_integer(I v, double& hi, double& lo) {
 // registers: calls of operator* and two_prod took a fifth to a quarter of an M8 step in dd. For dd_real
 // the operations are forced inline; the products are libqd's own code (qd/inline.h, qd/dd_inline.h)
 // repeated here with a forced-inline two_prod, operation for operation, so the results are bitwise
-// libqd's. Quad-double's operations, several times larger, are left to the compiler as before.
+// libqd's. Quad-double's operations, several times larger, are left to the compiler to inline or not.
 #if defined(__GNUC__) || defined(__clang__)
 #define NYSTROM_QD_FORCE_INLINE __attribute__((always_inline))
 #define NYSTROM_QD_NOINLINE __attribute__((noinline))

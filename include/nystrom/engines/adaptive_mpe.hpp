@@ -23,11 +23,11 @@
 // safety err^(-1/(p+1)))), p = 2n - 2, or Gustafsson's predictive ratio when smaller (the default,
 // adaptive_detail::StepController); no growth right after a rejection; Hairer's starting step unless
 // opt.h0 > 0; the last step lands exactly on t1; exact force counting (rejected steps and the
-// starting-step estimate included). (A PI controller was tried on Kepler e = 0.9 with M12: with the
-// usual beta it drives the error far below the tolerance, a mere rescaling of tol; not kept.) The
-// predictive ratio matters on Kepler e = 0.9: with the standard one, M14-adaptive rejected 500-700
-// steps per 3000 accepted (the optimal step falls by ~30% per step towards pericentre, faster than
-// the controller follows); predictive, 0-100, and the same final error costs 25-35% less time.
+// starting-step estimate included). There is no PI term: on Kepler e = 0.9 with M12, a PI controller
+// with the usual beta drives the error far below the tolerance, which only rescales tol. The predictive
+// ratio matters on Kepler e = 0.9, where the optimal step falls by ~30% per step towards pericentre,
+// faster than the standard ratio follows: with the standard ratio M14-adaptive rejects 500-700 steps
+// per 3000 accepted, with the predictive one 0-100, and the same final error costs 25-35% less time.
 //
 // Cost per step: sum k_i force evaluations (+1 for a base that starts with a kick: the force at q_0,
 // shared by all products and kept across a rejected step). The products of a step run in lockstep so
@@ -35,9 +35,9 @@
 // float the whole controller loop is compiled per product count (2..8), and for the three-step
 // (Verlet) bases of the catalog a step is trial_verlet: the products' increments, forces and
 // coefficients in local arrays, the product of largest k issued first in every sub-step (it is the
-// critical chain). An adaptive M12 step on Kepler e = 0.9 (21 forces, a chain of 6) measured 277 ns
-// before both, 231 ns with trial_verlet, 219 ns with the issue order too (the same run; a fixed-step
-// M12 step: about 145 ns, no error estimate and no step-size control on its chain of operations). The
+// critical chain). An adaptive M12 step on Kepler e = 0.9 (21 forces, a chain of 6) costs 277 ns as a
+// generic loop over the products, 231 ns as trial_verlet, 219 ns with the issue order too (one run; a
+// fixed-step M12 step: about 145 ns, no error estimate and no step-size control on its chain). The
 // sequential schedule (EngineOptions::mpe_schedule) runs the products one after the other with the
 // same operations: bitwise the same results.
 // The products run in increment form for every base whose steps merge (all symmetric ones): dq, dv
@@ -618,7 +618,7 @@ class AdaptiveMpeIntegrator {
       } else {
         // A step whose end time is exactly representable: the time reached is then the sum of the
         // steps taken, not its rounding (over 10^4 steps to t = 600 that rounding, ~1e-11 in time,
-        // was the round-off floor of the position error on Kepler).
+        // would be the round-off floor of the position error on Kepler).
         h = (t + h) - t;
       }
       if (!(h > tiny) || !(h > real_type(0))) {

@@ -38,15 +38,15 @@
 // ratios) runs in double through as_double, so any type with scalar_traits, epsilon_of, as_double,
 // abs and isfinite works (double, long double, float128, double_double, quad_double, mpfr_real).
 // Defaults: safety 0.9 (Hairer's DOP853 value) and fac_max 4. With the standard ratio alone, 0.9
-// rejected about one step in four on Kepler e = 0.5 and 0.9 (the exponent 1/11 of the 12(10) pair),
-// so 0.7 was the default until the predictive ratio came; with it, 0.9 rejects 5-15% of the steps
-// and costs fewer force evaluations than 0.7 for the same final error, for both engines (Kepler,
-// 100 periods, forces at error 1e-9 from a fit over 8 tolerances per decade: DP12-adaptive e = 0.5
-// 40 100 -> 36 600, e = 0.9 76 800 -> 73 900; M14-adaptive e = 0.9 138 800 -> 117 600). A high
-// order makes the difference larger: the controller aims at err = safety^(p+1), 0.005 for 0.7 and
-// p = 14 (M16-adaptive), 0.2 for 0.9; at tol 1e-12 the former lies below the round-off of the MPE's
-// error estimate (sum |d_i| ~ 175 times the increments' rounding), so M16-adaptive shrank its steps
-// for nothing (e = 0.5, error 1e-12: 1 457 000 forces at 0.7, 74 900 at 0.9).
+// rejects about one step in four on Kepler e = 0.5 and 0.9 (the exponent 1/11 of the 12(10) pair);
+// with the predictive ratio it rejects 5-15% of the steps and costs fewer force evaluations than 0.7
+// for the same final error, for both engines (Kepler, 100 periods, forces at error 1e-9 from a fit
+// over 8 tolerances per decade, 0.7 against 0.9: DP12-adaptive e = 0.5 40 100 / 36 600, e = 0.9
+// 76 800 / 73 900; M14-adaptive e = 0.9 138 800 / 117 600). A high order makes the difference larger:
+// the controller aims at err = safety^(p+1), 0.005 for 0.7 and p = 14 (M16-adaptive), 0.2 for 0.9; at
+// tol 1e-12 the former lies below the round-off of the MPE's error estimate (sum |d_i| ~ 175 times the
+// increments' rounding), so M16-adaptive would shrink its steps for nothing (e = 0.5, error 1e-12:
+// 1 457 000 forces at 0.7, 74 900 at 0.9).
 #pragma once
 
 #include <algorithm>

@@ -1,9 +1,9 @@
 // The methods of S. A. Chin, "Multi-product splitting and Runge-Kutta-Nyström integrators",
-// Celest. Mech. Dyn. Astron. 106 (2010) 391-406 (shared/papers/000_...):
+// Celest. Mech. Dyn. Astron. 106 (2010) 391-406:
 //   * velocity and position Verlet (eqs 25, 26), Forest-Ruth (position-first form compared in Fig 1);
 //   * the force-consolidated RKN methods as tableaux: Nyström 4 (eqs 28, 32), M4 (eqs 33-34),
 //     the new 5-force sixth-order method (eqs 39-47), Albrecht's A6 (eqs 61-62);
-//   * the forward fourth-order integrator A' (Fig 1; shared/NOTES.md, after Chin 2007 and Omelyan 2006);
+//   * the forward fourth-order integrator A' (Fig 1; after Chin 2007 and Omelyan 2006);
 //   * the multi-product integrators M4 ... M16 (natural sequence, PV base) of eq (17).
 // Tableau rows below are transcribed from the cited equations; the derivation is in the comments.
 #pragma once
@@ -27,7 +27,7 @@ inline std::vector<MethodDef> chin2010() {
                 .source = "Verlet; Chin (2010) eq (26)", .description = "position Verlet: drift h/2, kick h, drift h/2",
                 .aliases = {"position-verlet"}},
                [] { return MethodData{position_verlet_scheme()}; }});
-  // Forest & Ruth, Physica D 43 (1990) 105; theta = 1/(2 - 2^(1/3)); position-first form (NOTES.md).
+  // Forest & Ruth, Physica D 43 (1990) 105; theta = 1/(2 - 2^(1/3)); the position-first form Chin compares.
   m.push_back({{.name = "FR", .family = "splitting", .order = 4, .symmetric = true, .symplectic = true,
                 .source = "Forest & Ruth, Physica D 43 (1990) 105", .description = "Forest-Ruth, position-first",
                 .aliases = {"forest-ruth"}},
@@ -38,7 +38,7 @@ inline std::vector<MethodDef> chin2010() {
                                            kick(1 - 2 * theta), drift((1 - theta) * half), kick(theta),
                                            drift(theta * half)})};
                }});
-  // Forest-Ruth in the velocity-first form (different error constant; NOTES.md).
+  // Forest-Ruth in the velocity-first form (opposite sign and a several times larger error constant).
   m.push_back({{.name = "FR-V", .family = "splitting", .order = 4, .symmetric = true, .symplectic = true,
                 .source = "Forest & Ruth, Physica D 43 (1990) 105", .description = "Forest-Ruth, velocity-first", .aliases = {}},
                [] {
@@ -98,7 +98,7 @@ inline std::vector<MethodDef> chin2010() {
                                            {"7/90", "32/90", "12/90", "32/90", "7/90"})};
                }});
   // The forward integrator A' (all splitting coefficients positive), Fig 1; Chin, Int. J. Comput. Math.
-  // 84 (2007) 729 and Omelyan, Phys. Rev. E 74 (2006) 036703 (NOTES.md): one step is
+  // 84 (2007) 729 and Omelyan, Phys. Rev. E 74 (2006) 036703: one step is
   // v += h/6 a(q); q += h/2 v; v += 2h/3 a(q + h^2/24 a(q)); q += h/2 v; v += h/6 a(q).
   // As a tableau: y1 = q0; y2 = q0 + h/2 v0 + h^2/12 a1; y3 = y2 + h^2/24 a2; y4 = q1 (FSAL).
   m.push_back({{.name = "Aprime", .family = "rkn", .order = 4, .symmetric = true, .symplectic = false,

@@ -10,7 +10,7 @@
 //     integrators", Optim. Methods Softw. 20 (2005) 597: 35 stages, order 10.
 // Y6, KL6, KL8 and SS10 are the methods the Chin (2010) paper compares in its Figs. 2 and 3.
 //
-// The base leapfrog. Both forms are offered (NOTES.md): the position-first one (PV, Chin eq 26:
+// The base leapfrog. Both forms are offered (their error constants differ): the position-first one (PV, Chin eq 26:
 // drift h/2, kick h, drift h/2) is the DEFAULT; the velocity-first one (VV, eq 25) is named with a
 // "-V" suffix, as FR / FR-V in chin2010.hpp: Y6 = Y6 on PV, Y6-V = Y6 on VV. The parametric specs are
 // triplejump:P / triplejump-pv:P (PV) and triplejump-vv:P (VV), suzuki:P / suzuki-pv:P / suzuki-vv:P.

@@ -1,13 +1,13 @@
 // The fifth-order RKN splittings of M. A. Gürkan, "Fifth order Runge-Kutta-Nyström methods with
 // complex coefficients" (preprint, Leiden/Sabanci, 2012; the author's repository
-// atakan/Complex_Coeff_RKN gives it as submitted to Math. Comp.; shared/papers/002_...), and the
+// atakan/Complex_Coeff_RKN gives it as submitted to Math. Comp.), and the
 // complex third-order method of J. E. Chambers, "Symplectic integrators with complex time steps",
 // Astron. J. 126 (2003) 1119, which that paper compares (its ref. [11]).
 //
 // Operator order. The paper writes its schemes as operator products, applied right to left:
 //   RKNA, eq (3.6): e^{a6 tT} e^{b5 tV} e^{a5 tT} ... e^{b1 tV} e^{a1 tT}
 //   RKNB, eq (3.7): e^{b6 tV} e^{a5 tT} e^{b5 tV} ... e^{a1 tT} e^{b1 tV}
-// so in time order (our convention, NOTES.md) RKNA is drift a1, kick b1, drift a2, ..., kick b5,
+// so in time order (the catalog's convention) RKNA is drift a1, kick b1, drift a2, ..., kick b5,
 // drift a6 (the procedure after eq (3.5): y_1 = y_0 + h (c_1 - c_0) v first), and RKNB is kick b1,
 // drift a1, kick b2, ..., drift a5, kick b6. The authors' test program (testing/
 // err_check_dynamics_integrator.c: move_stars_RKNar1, _RKNbr1, _RKNac1) applies them the same way.
@@ -145,7 +145,7 @@ inline SplittingScheme<bigcomplex> gurkan_ac1_6() {
 }
 
 /// Chambers (2003): drift a1, kick b1, drift a2, kick b2, drift a3 with a1 = (1 + i/sqrt 3)/4,
-/// a2 = 1/2, a3 = conj a1, b1 = 2 a1, b2 = conj b1 (NOTES.md; Chambers' DKDKD form, upper signs).
+/// a2 = 1/2, a3 = conj a1, b1 = 2 a1, b2 = conj b1 (Chambers' DKDKD form, upper signs).
 inline SplittingScheme<bigcomplex> chambers2003() {
   const bigfloat s3 = boost::multiprecision::sqrt(bigfloat(3));
   const bigcomplex a1(big("1/4"), 1 / (4 * s3));

@@ -17,7 +17,7 @@
 //     ulp; the division and square-root units are several times slower than this short loop). Complex:
 //     z^{-3/2} (z = r^2 + eps^2) with two hardware square roots and one division, whose latency is hidden
 //     by computing z^{-3/2} for a whole block of partners of two rows first and accumulating after
-//     (a few ulp; 2.6-3x the real kernel's time per pair at N = 10 000, against 4.5x before). Particles
+//     (a few ulp; 2.6-3x the real kernel's time per pair at N = 10 000, 4.5x when accumulating per partner). Particles
 //     are grouped in blocks of B (B depends on N only); the block pairs are visited in the rounds of a
 //     round-robin tournament, so that within a round no two tiles touch the same block: the tiles of a
 //     round run in parallel (OpenMP) and every particle receives its contributions in the same order
