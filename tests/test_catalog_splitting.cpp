@@ -20,13 +20,14 @@ namespace {
 using LD = long double;
 using V2 = std::array<LD, 2>;
 
-// Every method added from the three headers (PV defaults, VV variants, Blanes-Moan, Gürkan, Chambers).
+// The splitting methods of three publication headers: compositions (PV defaults, VV variants),
+// Blanes-Moan, Gürkan (with Chambers).
 const std::vector<std::string> kCompositions = {"Y4", "Y6", "KL6", "KL8", "SS10", "Y4-V", "Y6-V", "KL6-V", "KL8-V", "SS10-V"};
 const std::vector<std::string> kBlanesMoan = {"RKNb6", "RKNa14"};
 const std::vector<std::string> kGurkanReal = {"AR1", "AR2", "BR1", "BR2", "BR3"};
 const std::vector<std::string> kGurkanComplex = {"AC1", "AC2", "BC1", "BC2", "AC1-6"};
 
-std::vector<std::string> all_new_methods() {
+std::vector<std::string> publication_splitting_methods() {
   std::vector<std::string> all;
   for (const auto* list : {&kCompositions, &kBlanesMoan, &kGurkanReal, &kGurkanComplex})
     all.insert(all.end(), list->begin(), list->end());
@@ -242,8 +243,8 @@ std::vector<bigfloat> kick_weights(const SplittingScheme<bigcomplex>& s) {
 
 // ---- registration and names ---------------------------------------------------------------------
 
-TEST(CatalogSplitting, NewMethodsAreRegisteredWithTheirAliases) {
-  for (const auto& name : all_new_methods()) {
+TEST(CatalogSplitting, PublicationSplittingMethodsAreRegisteredWithTheirSources) {
+  for (const auto& name : publication_splitting_methods()) {
     const MethodDef d = resolve_method(name);
     EXPECT_EQ(d.info.name, name);
     EXPECT_FALSE(d.info.source.empty()) << name;
@@ -288,7 +289,7 @@ TEST(CatalogSplitting, DriftsAndKicksEachSumToOne) {
     EXPECT_LT(cabs(sk - bigcomplex(bigfloat(1))), tol) << d.info.name << " kicks";
     ++checked;
   }
-  EXPECT_GE(checked, static_cast<int>(all_new_methods().size()) + 4);  // + VV, PV, FR, FR-V
+  EXPECT_GE(checked, static_cast<int>(publication_splitting_methods().size()) + 4);  // + VV, PV, FR, FR-V
 }
 
 TEST(CatalogSplitting, SymmetricFlagMatchesPalindromes) {
@@ -582,8 +583,8 @@ TEST(CatalogSplitting, ForcesPerStep) {
 
 // ---- adjoints ----------------------------------------------------------------------------------
 
-TEST(CatalogSplitting, AdjointOfEveryNewMethod) {
-  for (const auto& name : all_new_methods()) {
+TEST(CatalogSplitting, AdjointReversesEveryPublicationSplittingMethod) {
+  for (const auto& name : publication_splitting_methods()) {
     const MethodDef base = resolve_method(name);
     const MethodDef adj = resolve_method("adjoint:" + name);
     EXPECT_EQ(adj.info.name, "adjoint:" + name);
