@@ -468,17 +468,19 @@ TEST(NBodyIntegration, SplittingsConvergeAtTheirOrders) {
   };
   auto diff = [](const State<std::vector<double>>& a, const State<std::vector<double>>& b) {
     double d = 0;
-    for (std::size_t i = 0; i < a.q.size(); ++i) d = std::max({d, std::abs(a.q[i] - b.q[i]), std::abs(a.v[i] - b.v[i])});
+    for (std::size_t i = 0; i < a.q.size(); ++i)
+      d = std::max({d, std::abs(a.q[i] - b.q[i]), std::abs(a.v[i] - b.v[i])});
     return d;
   };
   for (int method = 0; method < 3; ++method) {
     const char* name = method == 0 ? "leapfrog" : method == 1 ? "Forest-Ruth" : "Chambers";
     const double order = method == 0 ? 2 : 4;
     std::vector<State<std::vector<double>>> x;
-    for (long n : {16, 32, 64, 128}) x.push_back(method == 0 ? run_real(lf, n) : method == 1 ? run_real(fr, n) : run_complex(n));
+    for (long n : {16, 32, 64, 128})
+      x.push_back(method == 0 ? run_real(lf, n) : method == 1 ? run_real(fr, n) : run_complex(n));
     const double d0 = diff(x[0], x[1]), d1 = diff(x[1], x[2]), d2 = diff(x[2], x[3]);
-    std::printf("[ nbody    ] %-12s differences %.3e %.3e %.3e  slopes %.3f %.3f\n", name, d0, d1, d2, std::log2(d0 / d1),
-                std::log2(d1 / d2));
+    std::printf("[ nbody    ] %-12s differences %.3e %.3e %.3e  slopes %.3f %.3f\n", name, d0, d1, d2,
+                std::log2(d0 / d1), std::log2(d1 / d2));
     EXPECT_NEAR(std::log2(d0 / d1), order, 0.35) << name << ": " << d0 << ", " << d1 << ", " << d2;
     EXPECT_NEAR(std::log2(d1 / d2), order, 0.35) << name << ": " << d0 << ", " << d1 << ", " << d2;
     EXPECT_GT(d2, 1e-13) << name << ": differences at the round-off level";

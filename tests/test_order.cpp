@@ -258,8 +258,8 @@ TEST(ObservedOrderOutsideTheCatalog, MultiProductSpecifications) {
     const MethodDef def = resolve_method(spec);
     ASSERT_EQ(def.info.order, order) << spec;
     const auto m = measure_catalog_order(def);
-    std::cout << "[ order    ] " << std::left << std::setw(16) << spec << " declared " << order << "  observed " << std::fixed
-              << std::setprecision(3) << m.observed << " (" << m.precision << ")" << std::endl;
+    std::cout << "[ order    ] " << std::left << std::setw(16) << spec << " declared " << order << "  observed "
+              << std::fixed << std::setprecision(3) << m.observed << " (" << m.precision << ")" << std::endl;
     EXPECT_TRUE(m.asymptotic) << spec << "\n" << m.log();
     EXPECT_TRUE(order_matches(order, m.observed, false)) << spec << " shows " << m.observed << "\n" << m.log();
   }

@@ -544,9 +544,9 @@ TEST_P(DefectOrder, ReversalDefectIsRoundingOrHasThePredictedOrder) {
   if (def.info.adaptive) GTEST_SKIP() << def.info.name << " is adaptive (its own step-size controller)";
   DefectSeries s;
   for (int i = 0; i < 3; ++i) s.d[static_cast<std::size_t>(i)] = qd_reversal_defect(def, std::ldexp(1.0, -3 - i));
+  const std::string flag = def.info.symmetric ? " (declared symmetric)" : " (declared non-symmetric)";
   expect_rounding_or_order(s, def.info.symmetric, predicted_reversal_order(def.info),
-                           def.info.name + (def.info.symmetric ? " (declared symmetric)" : " (declared non-symmetric)") +
-                               ", reversal defect at h = 1/8, 1/16, 1/32");
+                           def.info.name + flag + ", reversal defect at h = 1/8, 1/16, 1/32");
 }
 
 TEST_P(DefectOrder, SymplecticDefectIsRoundingOrHasThePredictedOrder) {
@@ -556,9 +556,9 @@ TEST_P(DefectOrder, SymplecticDefectIsRoundingOrHasThePredictedOrder) {
   const std::string flag = def.info.symplectic ? " (declared symplectic)" : " (declared non-symplectic)";
   DefectSeries kep, hh;
   for (int i = 0; i < 3; ++i) {
-    kep.d[static_cast<std::size_t>(i)] = qd_symplectic_defect(def, std::ldexp(1.0, -3 - i), kepler_start(), KeplerForce{});
-    hh.d[static_cast<std::size_t>(i)] =
-        qd_symplectic_defect(def, std::ldexp(1.0, -4 - i), kHenonStart, HenonHeilesForce{});
+    const auto k = static_cast<std::size_t>(i);
+    kep.d[k] = qd_symplectic_defect(def, std::ldexp(1.0, -3 - i), kepler_start(), KeplerForce{});
+    hh.d[k] = qd_symplectic_defect(def, std::ldexp(1.0, -4 - i), kHenonStart, HenonHeilesForce{});
   }
   const bool aprime = def.info.name == "Aprime";  // symplectic on Kepler only (see above)
   expect_rounding_or_order(kep, def.info.symplectic || aprime, predicted_symplectic_order(def.info),
