@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <vector>
 
@@ -52,8 +53,8 @@ AdaptiveOptions with_tol(double tol) {
 }  // namespace
 
 // Kepler e = 0.5 over one period in long double: the error follows the tolerance (below it: the
-// 12th-order solution is propagated while the 10th-order one is controlled) and the work grows
-// slowly, like tol^(-1/11).
+// 12th-order solution is propagated while the 10th-order one is controlled; measured 0.007-0.034 tol,
+// asserted within [1e-3 tol, tol]) and the work grows slowly, like tol^(-1/11).
 TEST(AdaptiveRkn, KeplerErrorTracksTheTolerance) {
   const KeplerProblem<LD> kp(0.5L);
   const MethodDef def = resolve_method("DP12-adaptive");
@@ -65,14 +66,17 @@ TEST(AdaptiveRkn, KeplerErrorTracksTheTolerance) {
     auto s = kp.initial_state();
     const AdaptiveStats st = ai.integrate_to(s, 0.0L, KeplerProblem<LD>::period());
     const double e = max_error(s, kp.exact(KeplerProblem<LD>::period()));
-    EXPECT_LE(e, 10 * tol) << "tol " << tol;
-    EXPECT_GE(e, 1e-4 * tol) << "tol " << tol;
+    EXPECT_LE(e, tol) << "tol " << tol;
+    EXPECT_GE(e, 1e-3 * tol) << "tol " << tol;
     errs.push_back(e);
     work.push_back(static_cast<double>(st.force_evals));
+    std::printf("[ adaptive ] tol %.0e  error %.3e  error/tol %.3g  forces %ld\n", tol, e, e / tol, st.force_evals);
     EXPECT_EQ(st.force_evals, 17 * (st.accepted + st.rejected) + 2);
   }
-  EXPECT_LT(errs[1], errs[0] / 10);
-  EXPECT_LT(errs[2], errs[1] / 10);
+  // Steps h ~ tol^(1/11) (the 10th-order estimate is controlled), local errors of the propagated 12th-order
+  // solution h^13: the global error goes like tol^(12/11). Measured over 1e-8 ... 1e-12: slope 1.17.
+  const double slope = std::log10(errs[0] / errs[2]) / 4;
+  EXPECT_NEAR(slope, 12.0 / 11.0, 0.2);
   EXPECT_GT(work[2], work[0]);
   EXPECT_LT(work[2], 4 * work[0]);  // 1e4 in tolerance, (1e4)^(1/11) = 2.3 in work
 }
@@ -174,6 +178,25 @@ TEST(AdaptiveRkn, StepLimitIsAClearError) {
   auto ai = make_adaptive_integrator<V2>(resolve_method("DP12-adaptive"), KeplerForce{}, o);
   auto s = KeplerProblem<LD>(0.5L).initial_state();
   EXPECT_THROW(ai.integrate_to(s, 0.0L, 100.0L), TooManySteps);
+}
+
+// The default controller (safety 0.9, fac_min 0.2, predictive ratio; engines/adaptive_rkn.hpp) rejects
+// a few steps but not many: its documented behaviour is 5-15% rejected steps on Kepler. A smaller
+// safety factor rejects almost none and spends more forces; a larger fac_min shrinks too little after
+// a rejection and rejects again. DP12-adaptive, Kepler e = 0.9, 3 periods, long double.
+TEST(AdaptiveRkn, DefaultControllerRejectsAFewSteps) {
+  const KeplerProblem<LD> kp(0.9L);
+  const MethodDef def = resolve_method("DP12-adaptive");
+  for (double tol : {1e-9, 1e-12}) {
+    auto ao = make_adaptive_integrator<V2>(def, KeplerForce{}, with_tol(tol));
+    auto s = kp.initial_state();
+    const AdaptiveStats st = ao.integrate_to(s, 0.0L, 3 * KeplerProblem<LD>::period());
+    const double frac = static_cast<double>(st.rejected) / static_cast<double>(st.accepted + st.rejected);
+    std::printf("[ adaptive ] e 0.9 tol %.0e  accepted %ld rejected %ld (%.1f%%)  forces %ld\n", tol, st.accepted,
+                st.rejected, 100 * frac, st.force_evals);
+    EXPECT_GT(frac, 0.03) << "tol " << tol;
+    EXPECT_LT(frac, 0.2) << "tol " << tol;
+  }
 }
 
 // The step ratio (shared by both adaptive engines): standard = safety * err^(-1/(p+1)); predictive

@@ -2,6 +2,7 @@
 // Plummer initial conditions, particle files, statistics.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <cstdio>
@@ -433,4 +434,55 @@ TEST(Stats, QuantilesInterpolateLinearly) {
   EXPECT_THROW(quantile(std::vector<double>{}, 0.5), std::invalid_argument);
   EXPECT_THROW(quantile(std::vector<double>{1, NAN}, 0.5), std::invalid_argument);
   EXPECT_THROW(quantile(std::vector<double>{1}, 1.5), std::invalid_argument);
+}
+
+TEST(NBodyIntegration, SplittingsConvergeAtTheirOrders) {
+  // Accuracy of whole N-body integrations: a softened Plummer sphere of 32 bodies (eps^2 = 1/N^2, as in
+  // Gurkan sec. 5) over t = 1/8, with n = 16, 32, 64, 128 steps. The differences d_n = |x_n - x_2n|
+  // (max-norm over all positions and velocities) fall like h^p: log2(d_n / d_2n) within 0.35 of p for
+  // the two finest pairs, leapfrog p = 2, Forest-Ruth p = 4, and Chambers' complex method with the
+  // imaginary parts dropped, which behaves as fourth order (Gurkan Fig. 5.2; formally third order).
+  auto p = plummer_sphere<double>(32, 7);
+  NBodyForce<double> f(p.m, 1.0 / (32.0 * 32.0));
+  NBodyForce<double> fc(p.m, 1.0 / (32.0 * 32.0));
+  const double t_end = 0.125;
+  const double theta = 1 / (2 - std::cbrt(2.0));
+  const SplittingScheme<double> lf{{{Flow::kick, 0.5}, {Flow::drift, 1.0}, {Flow::kick, 0.5}}};
+  const SplittingScheme<double> fr{{{Flow::drift, theta / 2}, {Flow::kick, theta}, {Flow::drift, (1 - theta) / 2},
+                                    {Flow::kick, 1 - 2 * theta}, {Flow::drift, (1 - theta) / 2}, {Flow::kick, theta},
+                                    {Flow::drift, theta / 2}}};
+  const C a1(0.25, 0.25 / std::sqrt(3.0));
+  const SplittingScheme<C> ch{{{Flow::drift, a1}, {Flow::kick, 2.0 * a1}, {Flow::drift, C(0.5)},
+                               {Flow::kick, std::conj(2.0 * a1)}, {Flow::drift, std::conj(a1)}}};
+  auto run_real = [&](const SplittingScheme<double>& m, long n) {
+    SplittingStepper<std::vector<double>, NBodyForce<double>> st(m, f);
+    auto s = p.s;
+    st.integrate(s, t_end / static_cast<double>(n), n);
+    return s;
+  };
+  auto run_complex = [&](long n) {
+    SplittingStepper<std::vector<C>, NBodyForce<double>> st(ch, fc);
+    auto z = convert_state<std::vector<C>>(p.s);
+    st.integrate(z, t_end / static_cast<double>(n), n);
+    return convert_state<std::vector<double>>(z);
+  };
+  auto diff = [](const State<std::vector<double>>& a, const State<std::vector<double>>& b) {
+    double d = 0;
+    for (std::size_t i = 0; i < a.q.size(); ++i)
+      d = std::max({d, std::abs(a.q[i] - b.q[i]), std::abs(a.v[i] - b.v[i])});
+    return d;
+  };
+  for (int method = 0; method < 3; ++method) {
+    const char* name = method == 0 ? "leapfrog" : method == 1 ? "Forest-Ruth" : "Chambers";
+    const double order = method == 0 ? 2 : 4;
+    std::vector<State<std::vector<double>>> x;
+    for (long n : {16, 32, 64, 128})
+      x.push_back(method == 0 ? run_real(lf, n) : method == 1 ? run_real(fr, n) : run_complex(n));
+    const double d0 = diff(x[0], x[1]), d1 = diff(x[1], x[2]), d2 = diff(x[2], x[3]);
+    std::printf("[ nbody    ] %-12s differences %.3e %.3e %.3e  slopes %.3f %.3f\n", name, d0, d1, d2,
+                std::log2(d0 / d1), std::log2(d1 / d2));
+    EXPECT_NEAR(std::log2(d0 / d1), order, 0.35) << name << ": " << d0 << ", " << d1 << ", " << d2;
+    EXPECT_NEAR(std::log2(d1 / d2), order, 0.35) << name << ": " << d0 << ", " << d1 << ", " << d2;
+    EXPECT_GT(d2, 1e-13) << name << ": differences at the round-off level";
+  }
 }
