@@ -10,7 +10,9 @@
 //   f.end_step(s)                 after every step (e.g. renormalisation in imaginary time);
 //   f.merge_across_steps()        false forbids merging the last sub-step of a step with the first of the
 //                                 next (a flow that is not a group in its coefficient: e^{aB} e^{bB} !=
-//                                 e^{(a+b)B}, such as a nonlinear potential flow). Default: merge.
+//                                 e^{(a+b)B}, such as a nonlinear potential flow). Default: merge. When
+//                                 steps merge, end_step() runs after the merged sub-step, so it must commute
+//                                 with the flows (a scalar renormalisation of a linear problem does).
 //
 // Classical drift/kick is one instance (A = v d/dq, B = a(q) d/dv); the Schrödinger equation (A = -iT,
 // B = -iV, quantum/) and a pair of matrices (tests) are others. The scheme's "drift" sub-steps are A,
@@ -67,7 +69,7 @@ void apply(F& f, typename F::state_type& s, Flow which, std::complex<R> z) {
 
 /// Runs a splitting scheme (real or complex coefficients) over flows F. Adjacent sub-steps of the same
 /// flow merge; in integrate() the last sub-step of a step merges with the first of the next unless the
-/// flows forbid it or need end_step() between steps.
+/// flows forbid it (merge_across_steps()).
 template <OperatorFlows F>
 class SplittingFlowStepper {
  public:
@@ -108,14 +110,14 @@ class SplittingFlowStepper {
     for (long i = 0; i < n; ++i) {
       for (std::size_t j = 1; j + 1 < st.size(); ++j) detail::apply(f, s, st[j].flow, st[j].coef * h);
       detail::apply(f, s, st.back().flow, i + 1 < n ? joined : st.back().coef * h);
+      detail::end_step(f, s);
     }
   }
 
   /// Whether integrate() merges the last sub-step of a step with the first of the next.
   bool merges(const F& f) const {
     const auto& st = scheme_.steps;
-    constexpr bool has_end = requires(F& g, state_type& x) { g.end_step(x); };
-    return !has_end && st.size() > 1 && st.front().flow == st.back().flow && detail::merge_across_steps(f);
+    return st.size() > 1 && st.front().flow == st.back().flow && detail::merge_across_steps(f);
   }
 
   /// Applications of flow A and of flow B in n steps of integrate().
