@@ -76,7 +76,8 @@ void plot_samples(const std::string& target, const QuantumResult& r, bool imagin
   {
     std::ofstream data(tmp / "data.txt");
     data.precision(17);
-    for (const auto& s : r.samples) data << s.time << " " << (imaginary ? s.energy : s.mean_x.at(0)) << " " << s.norm << "\n";
+    for (const auto& s : r.samples)
+      data << s.time << " " << (imaginary ? s.energy : s.mean_x.at(0)) << " " << s.norm << "\n";
   }
   {
     std::ofstream script(tmp / "plot.gp");
@@ -158,7 +159,7 @@ nlohmann::json to_json(const Options& o, const QuantumResult& r) {
 }
 
 nystrom::cli::Registrar reg(
-    "quantum", "Schrodinger / Gross-Pitaevskii split-operator propagation on a periodic grid (FFTW)", [](CLI::App& app) {
+    "quantum", "Schrodinger / Gross-Pitaevskii split-operator propagation on a periodic grid", [](CLI::App& app) {
       auto o = std::make_shared<Options>();
       app.add_option("--potential", o->potential,
                      "harmonic, anisotropic, morse, double-well, soft-coulomb, free (docs/quantum.md)")
@@ -210,7 +211,8 @@ nystrom::cli::Registrar reg(
         std::string mx;
         for (double x : r.mean_x) mx += fmt::format(" {:.12f}", x);
         fmt::print("<x>           {}\n", mx);
-        if (!r.exact_solution.empty()) fmt::print("error          {:.6e} (L2, against the {})\n", r.exact_error, r.exact_solution);
+        if (!r.exact_solution.empty())
+          fmt::print("error          {:.6e} (L2, against the {})\n", r.exact_error, r.exact_solution);
         fmt::print("FFTs           {}\n", r.fft_count);
         fmt::print("time           {:.6f} s\n", r.seconds);
         return 0;

@@ -141,7 +141,9 @@ double observed_order(const FlowMethod& m, std::string& log) {
   return order;
 }
 
-FlowMethod flow(const std::string& spec) { return resolve_flow_method(spec, OperatorStructure::general, 64, "long double"); }
+FlowMethod flow(const std::string& spec) {
+  return resolve_flow_method(spec, OperatorStructure::general, 64, "long double");
+}
 
 }  // namespace
 

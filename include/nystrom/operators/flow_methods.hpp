@@ -137,8 +137,8 @@ inline FlowMethod mpe_over(const std::string& spec, const std::string& base_spec
                   .symmetric = false,
                   .symplectic = false,
                   .complex = base.info.complex,
-                  .source = "Chin (2010) eq (27), extrapolation of a symmetric order-" + std::to_string(base.info.order) +
-                            " base",
+                  .source = "Chin (2010) eq (27), extrapolation of a symmetric order-" +
+                            std::to_string(base.info.order) + " base",
                   .description = "multi-product expansion {" + seq + "} over " + base.info.name,
                   .aliases = {}};
   return {info, m};

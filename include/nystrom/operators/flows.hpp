@@ -149,7 +149,8 @@ class MpeFlowStepper {
 
   MpeFlowStepper(const std::vector<long>& k, std::vector<real_type> c, const SplittingScheme<complex_type>& base)
       : k_(k), c_(std::move(c)) {
-    if (k_.empty() || k_.size() != c_.size()) throw std::invalid_argument("MPE: sequence and coefficients differ in size");
+    if (k_.empty() || k_.size() != c_.size())
+      throw std::invalid_argument("MPE: sequence and coefficients differ in size");
     std::size_t ref = 0;  // the product of largest k first
     for (std::size_t i = 0; i < k_.size(); ++i)
       if (k_[i] > k_[ref]) ref = i;

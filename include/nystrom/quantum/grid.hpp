@@ -24,7 +24,8 @@ struct Grid {
   Grid() = default;
   Grid(int d, int points, R length) : dims(d), n(points), box(length) {
     if (d < 1 || d > 3) throw std::invalid_argument("dims must be 1, 2 or 3, got " + std::to_string(d));
-    if (points < 2) throw std::invalid_argument("grid must have at least 2 points per axis, got " + std::to_string(points));
+    if (points < 2)
+      throw std::invalid_argument("grid must have at least 2 points per axis, got " + std::to_string(points));
     if (!(length > 0) || !std::isfinite(static_cast<double>(length)))
       throw std::invalid_argument("box must be positive and finite");
     std::size_t total = 1;
@@ -126,7 +127,8 @@ std::vector<R> sample_potential(const Grid<R>& g, const PotentialFunction<R>& v)
     g.indices(i, idx);
     for (int a = 0; a < g.dims; ++a) x[a] = g.coordinate(idx[a]);
     out[i] = v(x, g.dims);
-    if (!std::isfinite(static_cast<double>(out[i]))) throw std::invalid_argument("the potential is not finite on the grid");
+    if (!std::isfinite(static_cast<double>(out[i])))
+      throw std::invalid_argument("the potential is not finite on the grid");
   }
   return out;
 }

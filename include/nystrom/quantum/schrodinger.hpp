@@ -49,7 +49,11 @@ class SchrodingerFlows {
   using complex_type = std::complex<R>;
 
   SchrodingerFlows(const Grid<R>& grid, std::vector<R> potential, TimeKind kind, R g = 0, FftOptions fft = {})
-      : grid_(grid), v_(std::move(potential)), kind_(kind), g_(g), fft_(std::make_unique<FftPair<R>>(grid.shape(), fft)) {
+      : grid_(grid),
+        v_(std::move(potential)),
+        kind_(kind),
+        g_(g),
+        fft_(std::make_unique<FftPair<R>>(grid.shape(), fft)) {
     if (v_.size() != grid_.size()) throw std::invalid_argument("potential and grid differ in size");
     if (!std::isfinite(static_cast<double>(g))) throw std::invalid_argument("g must be finite");
     k2half_.resize(grid_.size());
