@@ -16,3 +16,23 @@ if(NOT TARGET nystrom_deps)
   # libquadmath ships with GCC (not in the default library path): link it by name.
   target_link_libraries(nystrom_deps INTERFACE Boost::headers ${QD_LIBRARY} ${MPFR_LIBRARY} ${GMPXX_LIBRARY} ${GMP_LIBRARY} quadmath)
 endif()
+
+# FFTW for the quantum layer (include/nystrom/quantum): fftw3 (double) and fftw3l (long double), with
+# threaded plans when fftw3_threads is found. Optional: without it the quantum tool, tests and benchmark
+# are not built.
+find_path(FFTW3_INCLUDE_DIR fftw3.h)
+find_library(FFTW3_LIBRARY fftw3)
+find_library(FFTW3L_LIBRARY fftw3l)
+find_library(FFTW3_THREADS_LIBRARY fftw3_threads)
+find_library(FFTW3L_THREADS_LIBRARY fftw3l_threads)
+if(FFTW3_INCLUDE_DIR AND FFTW3_LIBRARY AND FFTW3L_LIBRARY AND NOT TARGET nystrom_fftw)
+  add_library(nystrom_fftw INTERFACE)
+  add_library(nystrom::fftw ALIAS nystrom_fftw)
+  target_include_directories(nystrom_fftw INTERFACE ${FFTW3_INCLUDE_DIR})
+  if(FFTW3_THREADS_LIBRARY AND FFTW3L_THREADS_LIBRARY)
+    target_compile_definitions(nystrom_fftw INTERFACE NYSTROM_HAVE_FFTW_THREADS)
+    target_link_libraries(nystrom_fftw INTERFACE ${FFTW3_THREADS_LIBRARY} ${FFTW3L_THREADS_LIBRARY})
+  endif()
+  target_link_libraries(nystrom_fftw INTERFACE ${FFTW3_LIBRARY} ${FFTW3L_LIBRARY})
+  set(NYSTROM_HAVE_FFTW ON)
+endif()

@@ -1,0 +1,212 @@
+// The operator layer: splitting and multi-product methods for any evolution e^{h(A+B)}.
+//
+// A problem supplies its two flows, not a force. An object F models OperatorFlows when
+//   f.apply_a(s, z)   s <- e^{z A} s      (z complex: the sub-step's coefficient times h)
+//   f.apply_b(s, z)   s <- e^{z B} s
+//   f.assign(d, s)    d <- s               (d may be empty; it takes s's shape)
+//   f.scale(s, r)     s <- r s             (r real)
+//   f.axpy(d, r, s)   d <- d + r s         (the linear combination of the multi-product expansion)
+// with F::state_type, F::real_type. Optional members the engines use when present:
+//   f.end_step(s)                 after every step (e.g. renormalisation in imaginary time);
+//   f.merge_across_steps()        false forbids merging the last sub-step of a step with the first of the
+//                                 next (a flow that is not a group in its coefficient: e^{aB} e^{bB} !=
+//                                 e^{(a+b)B}, such as a nonlinear potential flow). Default: merge. When
+//                                 steps merge, end_step() runs after the merged sub-step, so it must commute
+//                                 with the flows (a scalar renormalisation of a linear problem does).
+//
+// Classical drift/kick is one instance (A = v d/dq, B = a(q) d/dv); the Schrödinger equation (A = -iT,
+// B = -iV, quantum/) and a pair of matrices (tests) are others. The scheme's "drift" sub-steps are A,
+// its "kicks" B, in the order they are applied.
+#pragma once
+
+#include <complex>
+#include <concepts>
+#include <cmath>
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nystrom/engines/splitting.hpp"  // SplittingScheme, normalized: method data only, not the classical engine
+
+namespace nystrom::operators {
+
+template <class F>
+concept OperatorFlows = requires(F& f, typename F::state_type& s, const typename F::state_type& cs,
+                                 std::complex<typename F::real_type> z, typename F::real_type r) {
+  f.apply_a(s, z);
+  f.apply_b(s, z);
+  f.assign(s, cs);
+  f.scale(s, r);
+  f.axpy(s, r, cs);
+};
+
+namespace detail {
+
+template <class F>
+void end_step(F& f, typename F::state_type& s) {
+  if constexpr (requires { f.end_step(s); }) f.end_step(s);
+}
+
+template <class F>
+bool merge_across_steps(const F& f) {
+  if constexpr (requires { f.merge_across_steps(); })
+    return f.merge_across_steps();
+  else
+    return true;
+}
+
+template <class F, class R>
+void apply(F& f, typename F::state_type& s, Flow which, std::complex<R> z) {
+  if (which == Flow::drift)
+    f.apply_a(s, z);
+  else
+    f.apply_b(s, z);
+}
+
+}  // namespace detail
+
+/// Runs a splitting scheme (real or complex coefficients) over flows F. Adjacent sub-steps of the same
+/// flow merge; in integrate() the last sub-step of a step merges with the first of the next unless the
+/// flows forbid it (merge_across_steps()).
+template <OperatorFlows F>
+class SplittingFlowStepper {
+ public:
+  using flows_type = F;
+  using state_type = typename F::state_type;
+  using real_type = typename F::real_type;
+  using complex_type = std::complex<real_type>;
+
+  explicit SplittingFlowStepper(const SplittingScheme<complex_type>& scheme) : scheme_(normalized(scheme)) {
+    if (scheme_.steps.empty()) throw std::invalid_argument("splitting scheme has no sub-steps");
+    for (const auto& s : scheme_.steps)
+      if (!std::isfinite(s.coef.real()) || !std::isfinite(s.coef.imag()))
+        throw std::invalid_argument("splitting coefficient is not finite");
+  }
+
+  const SplittingScheme<complex_type>& scheme() const { return scheme_; }
+
+  /// The sub-steps of one step, without end_step().
+  void apply_once(F& f, state_type& s, real_type h) const {
+    for (const auto& st : scheme_.steps) detail::apply(f, s, st.flow, st.coef * h);
+  }
+
+  void step(F& f, state_type& s, real_type h) const {
+    apply_once(f, s, h);
+    detail::end_step(f, s);
+  }
+
+  void integrate(F& f, state_type& s, real_type h, long n) const {
+    if (n <= 0) return;
+    if (!merges(f)) {
+      for (long i = 0; i < n; ++i) step(f, s, h);
+      return;
+    }
+    // the first sub-step; then per step the middle sub-steps and the last one merged with the next first
+    const auto& st = scheme_.steps;
+    detail::apply(f, s, st.front().flow, st.front().coef * h);
+    const complex_type joined = (st.back().coef + st.front().coef) * h;
+    for (long i = 0; i < n; ++i) {
+      for (std::size_t j = 1; j + 1 < st.size(); ++j) detail::apply(f, s, st[j].flow, st[j].coef * h);
+      detail::apply(f, s, st.back().flow, i + 1 < n ? joined : st.back().coef * h);
+      detail::end_step(f, s);
+    }
+  }
+
+  /// Whether integrate() merges the last sub-step of a step with the first of the next.
+  bool merges(const F& f) const {
+    const auto& st = scheme_.steps;
+    return st.size() > 1 && st.front().flow == st.back().flow && detail::merge_across_steps(f);
+  }
+
+  /// Applications of flow A and of flow B in n steps of integrate().
+  std::pair<long, long> applications(const F& f, long n) const {
+    long a = 0, b = 0;
+    for (const auto& s : scheme_.steps) (s.flow == Flow::drift ? a : b) += 1;
+    a *= n;
+    b *= n;
+    if (n > 1 && merges(f)) (scheme_.steps.front().flow == Flow::drift ? a : b) -= n - 1;
+    return {a, b};
+  }
+
+ private:
+  SplittingScheme<complex_type> scheme_;
+};
+
+/// Runs a multi-product expansion sum_i c_i B^{k_i}(h / k_i) over flows F, for any symmetric base
+/// splitting B (second order: Chin's eq 14 coefficients; higher even order p: the extrapolation in powers
+/// k^-p, k^-(p+2), ... of operators/flow_methods.hpp). Each product is one splitting scheme (k_i copies
+/// of the base at h/k_i, adjacent sub-steps merged). The combination is not a group element (neither
+/// unitary nor symplectic), so nothing merges across steps.
+template <OperatorFlows F>
+class MpeFlowStepper {
+ public:
+  using flows_type = F;
+  using state_type = typename F::state_type;
+  using real_type = typename F::real_type;
+  using complex_type = std::complex<real_type>;
+
+  MpeFlowStepper(const std::vector<long>& k, std::vector<real_type> c, const SplittingScheme<complex_type>& base)
+      : k_(k), c_(std::move(c)) {
+    if (k_.empty() || k_.size() != c_.size())
+      throw std::invalid_argument("MPE: sequence and coefficients differ in size");
+    std::size_t ref = 0;  // the product of largest k first
+    for (std::size_t i = 0; i < k_.size(); ++i)
+      if (k_[i] > k_[ref]) ref = i;
+    order_.push_back(ref);
+    for (std::size_t i = 0; i < k_.size(); ++i)
+      if (i != ref) order_.push_back(i);
+    for (long ki : k_) {
+      SplittingScheme<complex_type> p;
+      for (long r = 0; r < ki; ++r)
+        for (const auto& st : base.steps) p.steps.push_back({st.flow, st.coef / static_cast<real_type>(ki)});
+      products_.emplace_back(p);
+    }
+  }
+
+  const std::vector<long>& sequence() const { return k_; }
+  const std::vector<real_type>& coefficients() const { return c_; }
+
+  void step(F& f, state_type& s, real_type h) {
+    bool first = true;
+    for (std::size_t i : order_) {
+      f.assign(work_, s);
+      products_[i].apply_once(f, work_, h);
+      if (first) {
+        f.assign(sum_, work_);
+        f.scale(sum_, c_[i]);
+        first = false;
+      } else {
+        f.axpy(sum_, c_[i], work_);
+      }
+    }
+    using std::swap;
+    swap(s, sum_);
+    detail::end_step(f, s);
+  }
+
+  void integrate(F& f, state_type& s, real_type h, long n) {
+    for (long i = 0; i < n; ++i) step(f, s, h);
+  }
+
+  /// Applications of flow A and of flow B per step.
+  std::pair<long, long> applications(const F& f) const {
+    long a = 0, b = 0;
+    for (const auto& p : products_) {
+      const auto [pa, pb] = p.applications(f, 1);
+      a += pa;
+      b += pb;
+    }
+    return {a, b};
+  }
+
+ private:
+  std::vector<long> k_;
+  std::vector<real_type> c_;
+  std::vector<std::size_t> order_;
+  std::vector<SplittingFlowStepper<F>> products_;
+  state_type work_{}, sum_{};  // allocated on the first step, reused after
+};
+
+}  // namespace nystrom::operators

@@ -1,0 +1,222 @@
+// `nystrom quantum --potential harmonic --dims 1 --grid 256 --box 20 --method M8 --dt 0.05 --steps 200
+//  [--imaginary-time] [--x0 1] [--p0 0] [--g 0] [--precision double|long-double] [--json] [--plot FILE.png]`
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+#include "nystrom/quantum/solve.hpp"
+
+extern char** environ;
+
+namespace {
+
+using nystrom::cli::UsageError;
+using namespace nystrom::quantum;
+
+struct Options {
+  std::string potential = "harmonic";
+  int dims = 1;
+  int grid = 256;
+  std::string box = "20";
+  std::string method = "M8";
+  std::string dt = "0.05";
+  long steps = 200;
+  bool imaginary = false;
+  std::string x0 = "1", p0 = "0", g = "0", width = "1";
+  std::string precision = "double";
+  int threads = 1;
+  bool json = false;
+  std::string plot;
+};
+
+/// "1" (first axis) or "1,0,-0.5" (one value per axis).
+std::vector<double> parse_vector(const std::string& text, const std::string& what, int dims) {
+  std::vector<double> v;
+  for (const auto& item : nystrom::cli::split_list(text, what)) v.push_back(nystrom::cli::parse_double(item, what));
+  if (static_cast<int>(v.size()) > dims)
+    throw UsageError(what + " has " + std::to_string(v.size()) + " components for " + std::to_string(dims) +
+                     " dimension(s)");
+  return v;
+}
+
+/// Runs gnuplot on a script and data of fixed names in a fresh temporary folder (no shell, no user string
+/// in the script), then moves the picture to `target` (copied next to it first, so a failure leaves any
+/// existing file untouched).
+void plot_samples(const std::string& target, const QuantumResult& r, bool imaginary) {
+  namespace fs = std::filesystem;
+  if (target.empty()) throw UsageError("empty plot file name");
+  const fs::path out(target);
+  const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir)) throw UsageError("cannot write '" + target + "': folder does not exist");
+  std::string tmpl = (fs::temp_directory_path() / "nystrom-quantum-XXXXXX").string();
+  if (!::mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary folder for the plot");
+  const fs::path tmp(tmpl);
+  std::error_code ec;
+  struct Cleanup {
+    fs::path p;
+    ~Cleanup() {
+      std::error_code e;
+      fs::remove_all(p, e);
+    }
+  } cleanup{tmp};
+  {
+    std::ofstream data(tmp / "data.txt");
+    data.precision(17);
+    for (const auto& s : r.samples)
+      data << s.time << " " << (imaginary ? s.energy : s.mean_x.at(0)) << " " << s.norm << "\n";
+  }
+  {
+    std::ofstream script(tmp / "plot.gp");
+    script << "set terminal pngcairo size 900,600\nset output 'out.png'\nset grid\n"
+           << "set xlabel '" << (imaginary ? "imaginary time" : "time") << "'\n"
+           << "set ylabel '" << (imaginary ? "energy" : "<x_1>") << "'\nset y2label 'norm'\nset y2tics\n"
+           << "plot 'data.txt' using 1:2 with lines lw 2 title '" << (imaginary ? "energy" : "<x_1>")
+           << "', 'data.txt' using 1:3 axes x1y2 with lines title 'norm'\n";
+  }
+  std::string prog = "gnuplot", script = "plot.gp";
+  char* argv[] = {prog.data(), script.data(), nullptr};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  // gnuplot reads and writes relative to its working folder: run it in the temporary folder
+  const fs::path cwd = fs::current_path();
+  fs::current_path(tmp);
+  pid_t pid = 0;
+  const int rc = ::posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+  fs::current_path(cwd);
+  posix_spawn_file_actions_destroy(&actions);
+  int status = 0;
+  if (rc != 0 || ::waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
+      !fs::exists(tmp / "out.png"))
+    throw std::runtime_error("gnuplot failed to draw '" + target + "' (is gnuplot installed?)");
+  const fs::path staged = dir / ("." + out.filename().string() + ".tmp." + std::to_string(::getpid()));
+  fs::copy_file(tmp / "out.png", staged, fs::copy_options::overwrite_existing, ec);
+  if (!ec) fs::rename(staged, out, ec);
+  if (ec) {
+    fs::remove(staged, ec);
+    throw std::runtime_error("cannot write '" + target + "'");
+  }
+}
+
+template <class R>
+QuantumResult run(const Options& o) {
+  QuantumProblem<R> p;
+  p.dims = o.dims;
+  p.grid = o.grid;
+  p.box = static_cast<R>(nystrom::cli::parse_double(o.box, "--box", true));
+  p.potential = o.potential;
+  p.g = static_cast<R>(nystrom::cli::parse_double(o.g, "--g"));
+  p.time = o.imaginary ? TimeKind::imaginary : TimeKind::real;
+  for (double x : parse_vector(o.x0, "--x0", o.dims)) p.x0.push_back(static_cast<R>(x));
+  for (double x : parse_vector(o.p0, "--p0", o.dims)) p.p0.push_back(static_cast<R>(x));
+  p.width = static_cast<R>(nystrom::cli::parse_double(o.width, "--width", true));
+  p.fft.threads = o.threads;
+  const R dt = static_cast<R>(nystrom::cli::parse_double(o.dt, "--dt", true));
+  return solve(p, o.method, dt, o.steps, o.plot.empty() ? 0 : std::min<long>(o.steps, 400));
+}
+
+nlohmann::json to_json(const Options& o, const QuantumResult& r) {
+  auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  nlohmann::json j;
+  j["method"] = r.method;
+  j["order"] = r.order;
+  j["potential"] = o.potential;
+  j["dims"] = o.dims;
+  j["grid"] = o.grid;
+  j["box"] = nystrom::cli::parse_double(o.box, "--box", true);
+  j["dt"] = r.dt;
+  j["steps"] = r.steps;
+  j["time"] = r.time;
+  j["imaginary_time"] = o.imaginary;
+  j["g"] = nystrom::cli::parse_double(o.g, "--g");
+  j["precision"] = o.precision;
+  j["norm"] = r.norm;
+  j["norm_drift"] = r.norm_drift;
+  j["energy"] = r.energy;
+  j["chemical_potential"] = r.chemical_potential;
+  j["mean_position"] = r.mean_x;
+  j["mean_momentum"] = r.mean_p;
+  j["exact_solution"] = r.exact_solution.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.exact_solution);
+  j["exact_error"] = num(r.exact_error);
+  j["fft_count"] = r.fft_count;
+  j["seconds"] = r.seconds;
+  return j;
+}
+
+nystrom::cli::Registrar reg(
+    "quantum", "Schrodinger / Gross-Pitaevskii split-operator propagation on a periodic grid", [](CLI::App& app) {
+      auto o = std::make_shared<Options>();
+      app.add_option("--potential", o->potential,
+                     "harmonic, anisotropic, morse, double-well, soft-coulomb, free (docs/quantum.md)")
+          ->capture_default_str();
+      app.add_option("--dims", o->dims, "Dimensions: 1, 2 or 3")->capture_default_str();
+      app.add_option("--grid", o->grid, "Grid points per axis")->capture_default_str();
+      app.add_option("--box", o->box, "Box length L (the box is [-L/2, L/2) per axis)")->capture_default_str();
+      app.add_option("--method", o->method, "Splitting or MPE method (see `nystrom methods`; also mpe4:1,2,3)")
+          ->capture_default_str();
+      app.add_option("--dt", o->dt, "Step (real or imaginary time)")->capture_default_str();
+      app.add_option("--steps", o->steps, "Number of steps")->capture_default_str();
+      app.add_flag("--imaginary-time", o->imaginary, "Propagate in imaginary time (ground state), renormalising");
+      app.add_option("--x0", o->x0, "Initial centre: one number (first axis) or one per axis, comma-separated")
+          ->capture_default_str();
+      app.add_option("--p0", o->p0, "Initial momentum, like --x0")->capture_default_str();
+      app.add_option("--width", o->width, "Initial Gaussian width (1: harmonic coherent state)")->capture_default_str();
+      app.add_option("--g", o->g, "Gross-Pitaevskii coupling g (|psi|^2 normalised to 1)")->capture_default_str();
+      app.add_option("--precision", o->precision, "double or long-double")->capture_default_str();
+      app.add_option("--threads", o->threads, "FFTW threads")->capture_default_str();
+      app.add_flag("--json", o->json, "Print one JSON object");
+      app.add_option("--plot", o->plot, "Write <x_1>(t) (real time) or E(tau) (imaginary time) to this PNG");
+      return [o]() {
+        if (o->grid <= 0) throw UsageError("--grid must be positive, got " + std::to_string(o->grid));
+        if (o->dims < 1 || o->dims > 3) throw UsageError("--dims must be 1, 2 or 3, got " + std::to_string(o->dims));
+        if (o->steps < 0) throw UsageError("--steps must not be negative");
+        if (o->threads < 1) throw UsageError("--threads must be positive");
+        nystrom::cli::parse_double(o->box, "--box", true);
+        nystrom::cli::parse_double(o->dt, "--dt", true);
+        nystrom::cli::parse_double(o->g, "--g");
+        QuantumResult r;
+        if (o->precision == "double")
+          r = run<double>(*o);
+        else if (o->precision == "long-double")
+          r = run<long double>(*o);
+        else
+          throw UsageError("--precision must be double or long-double, got '" + o->precision + "'");
+        if (!o->plot.empty()) plot_samples(o->plot, r, o->imaginary);
+        if (o->json) {
+          std::cout << to_json(*o, r).dump(2) << "\n";
+          return 0;
+        }
+        fmt::print("method         {} (order {})\n", r.method, r.order);
+        fmt::print("problem        {} in {}D, {} points per axis, box {}, g = {}{}\n", o->potential, o->dims, o->grid,
+                   o->box, o->g, o->imaginary ? ", imaginary time" : "");
+        fmt::print("steps          {} of {:.6g} (time {:.6g})\n", r.steps, r.dt, r.time);
+        fmt::print("norm           {:.15f} (drift {:+.3e})\n", r.norm, r.norm_drift);
+        fmt::print("energy         {:.15f}\n", r.energy);
+        if (std::stod(o->g) != 0) fmt::print("chem. potential {:.15f}\n", r.chemical_potential);
+        std::string mx;
+        for (double x : r.mean_x) mx += fmt::format(" {:.12f}", x);
+        fmt::print("<x>           {}\n", mx);
+        if (!r.exact_solution.empty())
+          fmt::print("error          {:.6e} (L2, against the {})\n", r.exact_error, r.exact_solution);
+        fmt::print("FFTs           {}\n", r.fft_count);
+        fmt::print("time           {:.6f} s\n", r.seconds);
+        return 0;
+      };
+    });
+
+}  // namespace
