@@ -387,12 +387,17 @@ Progress::~Progress() {
 
 namespace {
 
-// A gnuplot single-quoted string of `s`: only printable ASCII without ' " \\ ` @ $ (anything else becomes '?'),
-// so no character can end the string, the line or the command, or start a substitution.
+// A gnuplot single-quoted string of `s`: printable ASCII without " \\ ` @ $ (anything else becomes '?'), a quote
+// doubled (gnuplot's escape inside single quotes), so no character can end the string, the line or the command,
+// or start a substitution.
 std::string gnuplot_literal(const std::string& s) {
   std::string out = "'";
   for (unsigned char c : s) {
-    const bool ok = c >= 0x20 && c < 0x7f && c != '\'' && c != '"' && c != '\\' && c != '`' && c != '@' && c != '$';
+    if (c == '\'') {
+      out += "''";
+      continue;
+    }
+    const bool ok = c >= 0x20 && c < 0x7f && c != '"' && c != '\\' && c != '`' && c != '@' && c != '$';
     out += ok ? static_cast<char>(c) : '?';
   }
   return out + "'";

@@ -162,7 +162,7 @@ struct PlotAxes {
 /// Draws a log-log plot with gnuplot (pngcairo) into png_path. Throws if gnuplot is missing or fails.
 /// gnuplot runs without a shell in a private temporary folder and writes a file of a fixed name there; the
 /// PNG is then written to png_path by write_file_atomic, so no path reaches gnuplot. Titles and labels keep
-/// only printable ASCII without quotes, backslashes, backquotes, '@' and '$' (others become '?').
+/// only printable ASCII without double quotes, backslashes, backquotes, '@' and '$' (others become '?').
 void plot_loglog(const std::string& png_path, const std::string& title, const std::string& xlabel,
                  const std::string& ylabel, const std::vector<Series>& series);
 
