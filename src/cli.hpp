@@ -9,13 +9,24 @@
 //     return [opt] { ...; return 0; };          // the action, run when this subcommand is chosen
 //   });
 //
-// Errors: throw nystrom::cli::UsageError (or std::invalid_argument) with one clear sentence; main()
-// prints "nystrom: error: <sentence>" on stderr and exits with status 2.
+// Errors: throw nystrom::cli::UsageError (or std::invalid_argument) with one clear sentence; run_main()
+// prints "nystrom: error: <sentence>" on stderr (one line, non-printable bytes escaped) and exits with status 2.
+// Every other failure (any exception, out of memory) ends the same way: one line, status 2.
+//
+// Input validation: every numeric option is checked as a whole string before CLI11 converts it (finite,
+// no empty string, no trailing characters, integers without exponent or fraction), and every text option
+// given explicitly must be non-empty; ranges are checked by each command. SIGINT/SIGTERM remove the temporary
+// files registered with TempFile and end the process with the signal's default status (130, 143).
 #pragma once
 
+#include <sys/types.h>
+
+#include <cstddef>
 #include <functional>
+#include <iosfwd>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -36,13 +47,77 @@ struct Command {
 
 std::vector<Command>& commands();
 
+/// The result of parsing a command line: the chosen subcommand's action, or an exit status to return
+/// at once (help was printed).
+struct Invocation {
+  Action action;
+  int exit_now = -1;
+};
+
+/// Parses and validates a command line against the registered subcommands without running anything.
+/// Throws UsageError (with one printable line) on any error; help goes to `help_out`.
+Invocation parse_command_line(int argc, const char* const* argv, std::ostream& help_out);
+
+/// The whole tool: installs the signal handlers, parses, runs the subcommand and maps every failure to
+/// one line "nystrom: error: ..." on stderr and exit status 2.
+int run_main(int argc, char** argv);
+
+/// `text` with every byte outside printable ASCII written as \xNN (and \n, \t, \\), cut to `max` characters.
+std::string printable(std::string_view text, std::size_t max = 400);
+
+/// Strict syntax of a decimal number: [+-]digits[.digits][(e|E)[+-]digits] (or .digits); no spaces, no
+/// hex, inf or nan. Returns an empty string when `text` is valid, otherwise what is wrong.
+std::string number_syntax_error(std::string_view text, bool integer);
+
+/// Parses a whole-string integer (no exponent or fraction) within [lo, hi]; `what` names it in errors.
+long long parse_integer(const std::string& text, const std::string& what, long long lo, long long hi);
+
+/// A count computed from doubles (e.g. N / f, duration / h): finite, within [1, max], else a UsageError.
+long checked_count(double value, double max, const std::string& what);
+
+/// Refuses work beyond the limit (1e14 units, or NYSTROM_WORK_LIMIT): `units` is the estimate in force
+/// evaluations of a double Kepler force (an N-body force of n bodies counts n(n-1)/2). The message gives the
+/// estimate.
+void check_work_budget(double units, const std::string& what);
+
+/// CLI11 checks of an eccentricity (0 <= e < 1) and of a tolerance (positive, at least 1e-300).
+CLI::Validator eccentricity_check();
+CLI::Validator tolerance_check();
+
+/// Relative cost of one force evaluation in a scalar type (double 1; measured ratios of bench_precision).
+double precision_cost(const std::string& precision);
+
+/// A temporary file or folder removed when this object goes, and also by the SIGINT/SIGTERM handler.
+class TempFile {
+ public:
+  TempFile() = default;
+  explicit TempFile(std::string path, bool directory = false);
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  ~TempFile();
+  const std::string& path() const { return path_; }
+  /// The file was renamed into place: nothing to remove.
+  void release();
+
+ private:
+  std::string path_;
+  int slot_ = -1;
+  bool directory_ = false;
+};
+
+/// The child process that the signal handler terminates too (gnuplot); 0: none.
+void set_signal_child(pid_t pid);
+
 struct Registrar {
   Registrar(std::string name, std::string help, Setup setup) {
     commands().push_back({std::move(name), std::move(help), std::move(setup)});
   }
 };
 
-/// Writes `content` to `path` atomically (a temporary file in the same folder, then rename).
+/// Writes `content` to `path`. A regular file (or a new path) is replaced atomically: a temporary file in the
+/// same folder, then rename; a symbolic link is followed and its target replaced in the target's folder;
+/// anything else (FIFO, device, /dev/stdout, a path under /dev or /proc) is written in place. Refuses an empty
+/// path and a folder; errors carry the system's reason.
 void write_file_atomic(const std::string& path, const std::string& content);
 
 /// Parses a number that must be finite (and positive if `positive`); `what` names it in errors.
@@ -55,8 +130,8 @@ std::vector<double> parse_log_range(const std::string& text, const std::string& 
 /// Splits "a,b,c"; empty items are errors.
 std::vector<std::string> split_list(const std::string& text, const std::string& what);
 
-/// A progress line on stderr for long runs ("label [####----] 12/40"), only when stderr is a terminal
-/// or NYSTROM_PROGRESS=1.
+/// A progress line on stderr for long runs ("label [####----] 12/40, 3 s, ETA 9 s"), only when stderr is a
+/// terminal or NYSTROM_PROGRESS=1; redrawn at most ten times a second.
 class Progress {
  public:
   Progress(std::string label, long total);
@@ -67,6 +142,8 @@ class Progress {
   std::string label_;
   long total_;
   bool enabled_;
+  double start_ = 0, last_ = -1;
+  bool drawn_ = false;
 };
 
 /// One curve of a plot: x, y pairs (on a log axis, non-positive values are skipped).
@@ -83,6 +160,9 @@ struct PlotAxes {
 };
 
 /// Draws a log-log plot with gnuplot (pngcairo) into png_path. Throws if gnuplot is missing or fails.
+/// gnuplot runs without a shell in a private temporary folder and writes a file of a fixed name there; the
+/// PNG is then written to png_path by write_file_atomic, so no path reaches gnuplot. Titles and labels keep
+/// only printable ASCII without double quotes, backslashes, backquotes, '@' and '$' (others become '?').
 void plot_loglog(const std::string& png_path, const std::string& title, const std::string& xlabel,
                  const std::string& ylabel, const std::vector<Series>& series);
 

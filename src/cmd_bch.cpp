@@ -13,6 +13,7 @@
 
 #include "cli.hpp"
 #include "nystrom/analysis/bch.hpp"
+#include "nystrom/analysis/method_file.hpp"
 #include "nystrom/methods/catalog.hpp"
 
 namespace {
@@ -77,7 +78,8 @@ int run(const Options& o) {
   if (o.method.empty()) throw nystrom::cli::UsageError("bch needs --method NAME (or --gurkan-table)");
   an::check_degree(o.degree);
   if (o.bits < 64 || o.bits > 4096) throw nystrom::cli::UsageError("--bits must be between 64 and 4096");
-  if (!(o.tolerance >= 0)) throw nystrom::cli::UsageError("--tolerance must be >= 0");
+  if (!(o.tolerance >= 0) || !std::isfinite(o.tolerance) || o.tolerance >= 1)
+    throw nystrom::cli::UsageError("--tolerance must be >= 0 and below 1");
   an::AnalysisOptions opt;
   opt.degree = o.degree;
   opt.basis = an::parse_basis(o.basis);
@@ -85,6 +87,12 @@ int run(const Options& o) {
   opt.precision_bits = o.bits;
   opt.tolerance = o.tolerance;
   const auto def = nystrom::resolve_method(o.method);
+  {
+    nystrom::BigPrecision guard(64);
+    const auto data = def.build();
+    if (const auto* sp = std::get_if<nystrom::SplittingScheme<nystrom::bigcomplex>>(&data))
+      an::check_bch_work(sp->steps.size(), o.degree, "bch --method " + o.method);
+  }
   const an::MethodAnalysis a = an::analyze_method(def, opt);
   const std::string order_text =
       a.order_is_lower_bound ? ">= " + std::to_string(a.order) : std::to_string(a.order);

@@ -87,7 +87,9 @@ nystrom::cli::Registrar reg(
       auto o = std::make_shared<Options>();
       app.add_flag("--quick", o->quick, "Coarse sweeps, one repetition, small force budget (a test run)");
       app.add_option("--out", o->out, "Output folder (created if missing)")->capture_default_str();
-      app.add_option("--periods", o->periods, "Orbital periods per run")->capture_default_str();
+      app.add_option("--periods", o->periods, "Orbital periods per run (1..10000)")
+          ->capture_default_str()
+          ->check(CLI::Range(1L, 10000L));
       app.add_option("--ecc", o->eccs, "Comma-separated eccentricities")->capture_default_str();
       app.add_flag("--no-plot", o->no_plot, "Do not draw the PNG charts");
       return [o]() {
@@ -125,6 +127,11 @@ nystrom::cli::Registrar reg(
             progress.tick(++done);
           }
         }
+        // A comparison needs finished runs of both libraries; all-failed sweeps are a failure, not a result.
+        for (const char* lib : {"nystrom", "odeint"})
+          if (std::none_of(runs.begin(), runs.end(), [&](const np::PeerRun& r) { return r.library == lib && r.ok; }))
+            throw std::runtime_error(std::string("bench-peers: no run of ") + lib +
+                                     " finished with a finite error (every run diverged or exceeded its budget)");
 
         nlohmann::json j;
         j["problem"] = "Kepler, q0 = (1+e, 0), v0 = (0, sqrt((1-e)/(1+e))), period 2 pi";

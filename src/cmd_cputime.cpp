@@ -23,17 +23,24 @@ nystrom::cli::Registrar reg("cputime", "CPU time per step of N-body integrations
                               auto o = std::make_shared<Options>();
                               auto& s = o->cfg.setup;
                               app.add_option("--problem", s.problem, "Problem: nbody or twobody")->capture_default_str();
-                              app.add_option("--n", s.n, "Particles of the Plummer sphere")->capture_default_str();
+                              app.add_option("--n", s.n, "Particles of the Plummer sphere")
+                                  ->capture_default_str()
+                                  ->check(CLI::Range(2L, 1000000L));
                               app.add_option("--seed", s.seed, "Seed of the Plummer sphere")->capture_default_str();
                               app.add_option("--ic", s.ic_file, "Particle file instead of a Plummer sphere");
-                              app.add_option("--eps", o->eps, "Softening length (default 1/N)");
-                              app.add_option("--threads", s.threads, "Force threads (0: OpenMP default)")->capture_default_str();
+                              app.add_option("--eps", o->eps, "Softening length (default 1/N)")->check(CLI::NonNegativeNumber);
+                              app.add_option("--threads", s.threads, "Force threads (0: OpenMP default)")
+                                  ->capture_default_str()
+                                  ->check(CLI::Range(0, 1024));
                               app.add_option("--methods", o->methods, "Comma-separated methods (the leapfrog is always measured)")
                                   ->capture_default_str();
-                              app.add_option("--h", o->cfg.h, "Step size")->capture_default_str();
-                              app.add_option("--steps", o->cfg.steps, "Timed steps per measurement")->capture_default_str();
+                              app.add_option("--h", o->cfg.h, "Step size")->capture_default_str()->check(CLI::PositiveNumber);
+                              app.add_option("--steps", o->cfg.steps, "Timed steps per measurement")
+                                  ->capture_default_str()
+                                  ->check(CLI::Range(1, 1000000));
                               app.add_option("--repeats", o->cfg.repeats, "Measurements per method (the minimum is kept)")
-                                  ->capture_default_str();
+                                  ->capture_default_str()
+                                  ->check(CLI::Range(1, 1000));
                               app.add_option("--csv", o->csv, "Write the table as CSV");
                               return [o]() {
                                 using namespace nystrom::cli;
@@ -41,6 +48,14 @@ nystrom::cli::Registrar reg("cputime", "CPU time per step of N-body integrations
                                 cfg.methods = split_list(o->methods, "--methods");
                                 if (o->eps >= 0) cfg.setup.eps2 = o->eps * o->eps;
                                 else if (o->eps != -1) throw UsageError("--eps must be >= 0");
+                                {
+                                  const double n = cfg.setup.ic_file.empty() ? static_cast<double>(cfg.setup.n) : 2.0;
+                                  double forces = 1;
+                                  for (const auto& m : cfg.methods)
+                                    forces += std::max(1, nystrom::resolve_method(m).info.forces_per_step);
+                                  check_work_budget(forces * static_cast<double>(cfg.steps) * cfg.repeats * n * (n - 1) / 2,
+                                                    "cputime");
+                                }
                                 std::unique_ptr<Progress> p;
                                 const auto res = nystrom::run_cputime(cfg, [&](long done, long all) {
                                   if (!p) p = std::make_unique<Progress>("cputime", all);

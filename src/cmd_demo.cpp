@@ -1,6 +1,7 @@
 // `nystrom demo`: the main job on a built-in default problem. A precision-effort sweep on the Kepler
 // orbit at e = 0.9 (Chin's Figs 1-3 in miniature): symplectic Forest-Ruth against the RKN methods and
 // the multi-product integrators of orders 4-10; a table on the terminal, demo.csv and demo.png.
+#include <filesystem>
 #include <memory>
 
 #include <fmt/core.h>
@@ -27,6 +28,9 @@ nystrom::cli::Registrar reg("demo", "Precision-effort sweep on Kepler e = 0.9: t
                               app.add_option("--precision", o->precision, "Scalar type")->capture_default_str();
                               return [o]() {
                                 using namespace nystrom::cli;
+                                if (o->out_dir.empty()) throw UsageError("--out-dir must not be empty");
+                                if (!std::filesystem::is_directory(o->out_dir))  // before the sweep, not after it
+                                  throw UsageError("--out-dir '" + o->out_dir + "' is not an existing folder");
                                 SweepRequest req;
                                 req.base.problem = "kepler";
                                 req.base.ecc = 0.9;

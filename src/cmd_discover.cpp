@@ -314,12 +314,16 @@ nystrom::cli::Registrar reg(
     "discover", "Find fifth-order RKN splittings from the order conditions (Gurkan sec. 4, eq 6.1)", [](CLI::App& app) {
       auto o = std::make_shared<Options>();
       app.add_option("--scheme", o->scheme, "A (RKNA, eq 3.6), B (RKNB, eq 3.8) or both")->capture_default_str();
-      app.add_option("--starts", o->starts, "Random starts per scheme")->capture_default_str();
+      app.add_option("--starts", o->starts, "Random starts per scheme")->capture_default_str()->check(CLI::Range(1L, 1000000L));
       app.add_option("--seed", o->seed, "Seed of the random starts")->capture_default_str();
-      app.add_option("--threads", o->threads, "Threads (0: all cores, at most 8)")->capture_default_str();
+      app.add_option("--threads", o->threads, "Threads (0: all cores, at most 8)")->capture_default_str()->check(CLI::Range(0, 256));
       app.add_option("--solver", o->solver, "newton (damped) or lm (Levenberg-Marquardt)")->capture_default_str();
-      app.add_option("--box", o->box, "Starts uniform in [-box, box] for real and imaginary parts")->capture_default_str();
-      app.add_option("--polish-bits", o->polish_bits, "MPFR precision of the final Newton polish")->capture_default_str();
+      app.add_option("--box", o->box, "Starts uniform in [-box, box] for real and imaginary parts")
+          ->capture_default_str()
+          ->check(CLI::Range(1e-6, 1e6));
+      app.add_option("--polish-bits", o->polish_bits, "MPFR precision of the final Newton polish")
+          ->capture_default_str()
+          ->check(CLI::Range(64u, 4096u));
       app.add_option("--digits", o->digits, "Digits printed")->capture_default_str();
       app.add_option("--show", o->show, "Methods listed: classified (REAL, IMAGINARY, positive), all, real, imaginary, positive")
           ->capture_default_str();
@@ -330,9 +334,14 @@ nystrom::cli::Registrar reg(
       app.add_flag("--six-stage", o->six, "Eq (6.1): minimise the sixth-order error of a six-stage method near --from");
       app.add_option("--from", o->from, "Start of --six-stage (an RKNA method)")->capture_default_str();
       app.add_option("--tries", o->tries, "--six-stage: the start plus tries-1 random moves along the constraints")
-          ->capture_default_str();
-      app.add_option("--perturbation", o->perturbation, "--six-stage: size of the random moves")->capture_default_str();
-      app.add_option("--six-bits", o->six_bits, "--six-stage: MPFR precision of the final polish (0: none)")->capture_default_str();
+          ->capture_default_str()
+          ->check(CLI::Range(1, 100000));
+      app.add_option("--perturbation", o->perturbation, "--six-stage: size of the random moves")
+          ->capture_default_str()
+          ->check(CLI::Range(0.0, 1e3));
+      app.add_option("--six-bits", o->six_bits, "--six-stage: MPFR precision of the final polish (0: none)")
+          ->capture_default_str()
+          ->check(CLI::Range(0u, 4096u));
       app.footer(
           "Rediscovering Gurkan's Tables 4.1 and 4.2: `nystrom discover --seed 1` (2000 starts per scheme, the default)\n"
           "finds all nine published methods (AR1 AR2 AC1 AC2 among the RKNA solutions, BR1 BR2 BR3 BC1 BC2 among the\n"

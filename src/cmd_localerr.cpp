@@ -25,18 +25,19 @@ nystrom::cli::Registrar reg(
       auto o = std::make_shared<Options>();
       auto& s = o->cfg.setup;
       app.add_option("--problem", s.problem, "Problem: nbody (Plummer sphere or --ic file) or twobody")->capture_default_str();
-      app.add_option("--n", s.n, "Particles of the Plummer sphere")->capture_default_str();
+      app.add_option("--n", s.n, "Particles of the Plummer sphere")->capture_default_str()->check(CLI::Range(2L, 1000000L));
       app.add_option("--seed", s.seed, "Seed of the Plummer sphere")->capture_default_str();
       app.add_option("--ic", s.ic_file, "Particle file (m,x,y,z,vx,vy,vz per line) instead of a Plummer sphere");
-      app.add_option("--ecc", s.ecc, "Two-body eccentricity")->capture_default_str();
-      app.add_option("--eps", o->eps, "Softening length (default 1/N for nbody, 0 for twobody)");
-      app.add_option("--threads", s.threads, "Force threads (0: OpenMP default)")->capture_default_str();
+      app.add_option("--ecc", s.ecc, "Two-body eccentricity")->capture_default_str()->check(nystrom::cli::eccentricity_check());
+      app.add_option("--eps", o->eps, "Softening length (default 1/N for nbody, 0 for twobody)")->check(CLI::NonNegativeNumber);
+      app.add_option("--threads", s.threads, "Force threads (0: OpenMP default)")->capture_default_str()->check(CLI::Range(0, 1024));
       app.add_option("--methods", o->methods, "Comma-separated methods")->capture_default_str();
       app.add_option("--h", o->hs, "FROM:TO:COUNT step sizes, log-spaced (orbital periods for twobody, time units for nbody)")
           ->capture_default_str();
       app.add_option("--duration", o->cfg.duration,
-                     "Length of the run (default: 50 periods for twobody, 1 time unit for nbody)");
-      app.add_option("--tol", o->cfg.tol, "GBS tolerance")->capture_default_str();
+                     "Length of the run (default: 50 periods for twobody, 1 time unit for nbody)")
+          ->check(CLI::PositiveNumber);
+      app.add_option("--tol", o->cfg.tol, "GBS tolerance")->capture_default_str()->check(nystrom::cli::tolerance_check());
       app.add_option("--gbs-sequence", o->sequence, "GBS step-size sequence: harmonic, romberg, bulirsch")
           ->capture_default_str();
       app.add_option("--csv", o->csv, "Write the table as CSV");
@@ -49,6 +50,19 @@ nystrom::cli::Registrar reg(
         cfg.sequence = nystrom::parse_gbs_sequence(o->sequence);
         if (o->eps >= 0) cfg.setup.eps2 = o->eps * o->eps;
         else if (o->eps != -1) throw UsageError("--eps must be >= 0");
+        {  // steps per h and the work: every method and the GBS reference (about 100 forces per step) per step
+          const bool two = cfg.setup.problem == "twobody";
+          const double duration = cfg.duration > 0 ? cfg.duration : (two ? 50.0 : 1.0);
+          const double n = two ? 2.0 : cfg.setup.ic_file.empty() ? static_cast<double>(cfg.setup.n) : 2.0;
+          double forces = 100;
+          for (const auto& m : cfg.methods) forces += std::max(1, nystrom::resolve_method(m).info.forces_per_step);
+          double work = 0;
+          for (double h : cfg.hs) {
+            const long steps = checked_count(duration / h, 1e8, "--duration / --h: the number of steps");
+            work += static_cast<double>(steps) * forces * n * (n - 1) / 2;
+          }
+          check_work_budget(work, "localerr");
+        }
         long total = 0;
         std::unique_ptr<Progress> p;
         const auto res = nystrom::run_localerr(cfg, [&](long done, long all) {

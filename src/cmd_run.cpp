@@ -8,6 +8,7 @@
 #include "nystrom/methods/catalog.hpp"
 #include "runner.hpp"
 #include "runner_solve.hpp"
+#include "sweep.hpp"
 
 namespace {
 
@@ -23,18 +24,26 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--problem", o->req.problem,
                  "Problem: kepler (Chin eqs 35-36), harmonic, twobody (two equal masses), nbody (Plummer sphere)")
       ->capture_default_str();
-  app.add_option("--n", o->req.n, "nbody: number of particles of the Plummer sphere")->capture_default_str();
+  app.add_option("--n", o->req.n, "nbody: number of particles of the Plummer sphere")
+      ->capture_default_str()
+      ->check(CLI::Range(2L, 1000000L));
   app.add_option("--seed", o->req.seed, "nbody: seed of the Plummer sample")->capture_default_str();
   app.add_option("--ic", o->req.ic_file, "nbody: particle file (m x y z vx vy vz per line)");
-  app.add_option("--eps2", o->req.eps2, "nbody: softening squared (default (1/N)^2; twobody 0)");
-  app.add_option("--h", o->req.h, "nbody: step size")->capture_default_str();
-  app.add_option("--steps", o->req.steps, "nbody: number of steps")->capture_default_str();
-  app.add_option("--ecc", o->req.ecc, "Kepler eccentricity, 0 <= e < 1")->capture_default_str();
+  app.add_option("--eps2", o->req.eps2, "nbody: softening squared (default (1/N)^2; twobody 0)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--h", o->req.h, "nbody: step size")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--steps", o->req.steps, "nbody: number of steps")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--ecc", o->req.ecc, "Kepler eccentricity, 0 <= e < 1")
+      ->capture_default_str()
+      ->check(nystrom::cli::eccentricity_check());
   app.add_option("--method", o->method, "Method name or spec (see `nystrom methods`)")->required();
-  app.add_option("--steps-per-period", o->req.steps_per_period, "Steps per orbital period")->capture_default_str();
-  app.add_option("--periods", o->req.periods, "Number of whole periods")->capture_default_str();
+  app.add_option("--steps-per-period", o->req.steps_per_period, "Steps per orbital period")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--periods", o->req.periods, "Number of whole periods")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--precision", o->req.precision, "Scalar type (double, long-double, ...)")->capture_default_str();
-  app.add_option("--tol", o->req.tol, "Tolerance of an adaptive method (e.g. DP12-adaptive)");
+  app.add_option("--tol", o->req.tol, "Tolerance of an adaptive method (e.g. DP12-adaptive)")
+      ->check(nystrom::cli::tolerance_check());
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
   app.add_option("--output-times", o->sreq.output_times,
                  "Kepler: A:B:N, the state at N equally spaced times from A to B (dense output; JSON `output`)");
@@ -45,6 +54,7 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_flag("--json", o->json, "Print one JSON object");
   return [o]() {
     const auto def = nystrom::cli::resolve_run_method(o->method);
+    nystrom::cli::check_work_budget(nystrom::cli::run_work_units(o->req, def), "run");
     if (o->sreq.any()) {
       const auto r = nystrom::cli::run_kepler_solve(o->req, o->sreq, def);
       auto j = r.report.to_json();

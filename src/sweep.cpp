@@ -11,17 +11,40 @@
 
 namespace nystrom::cli {
 
+double run_work_units(const RunRequest& req, const MethodDef& def) {
+  const bool nbody = req.problem == "nbody";
+  double force_cost = precision_cost(req.precision);
+  if (nbody) {
+    const double n = static_cast<double>(req.n);
+    force_cost = std::max(1.0, n * (n - 1) / 2);
+  }
+  if (def.info.adaptive) return force_cost;
+  const double steps = nbody ? static_cast<double>(req.steps)
+                             : static_cast<double>(req.steps_per_period) * static_cast<double>(req.periods);
+  return steps * std::max(1, def.info.forces_per_step) * force_cost;
+}
+
 std::vector<SweepRow> run_sweep(const SweepRequest& req) {
   if (req.methods.empty()) throw UsageError("no methods given");
   if (req.force_evals.empty()) throw UsageError("no force-evaluation counts given");
   std::vector<MethodDef> defs;
   for (const auto& m : req.methods) defs.push_back(resolve_run_method(m));  // fail early on unknown names
   long total = 0;
+  double work = 0;
   for (const auto& def : defs) {
     if (def.info.adaptive && req.tols.empty())
       throw UsageError("method '" + def.info.name + "' is adaptive: give --tols FROM:TO:COUNT");
     total += static_cast<long>(def.info.adaptive ? req.tols.size() : req.force_evals.size());
+    const int f = std::max(1, def.info.forces_per_step);
+    for (double N : def.info.adaptive ? std::vector<double>{} : req.force_evals) {
+      RunRequest r = req.base;
+      const long steps = checked_count(N / f, 1e9, "--force-evals: the steps per period of " + def.info.name);
+      r.steps = r.steps_per_period = steps;
+      if (r.problem != "nbody") r.steps = 1;
+      work += run_work_units(r, def);
+    }
   }
+  check_work_budget(work, "sweep");
   std::vector<SweepRow> rows;
   Progress progress("sweep", total);
   long done = 0;
@@ -47,7 +70,7 @@ std::vector<SweepRow> run_sweep(const SweepRequest& req) {
     long last_steps = -1;
     for (double N : req.force_evals) {
       RunRequest r = req.base;
-      const long steps = std::max(1L, std::lround(N / f));
+      const long steps = checked_count(N / f, 1e9, "--force-evals: the steps per period");
       progress.tick(++done);
       if (steps == last_steps) continue;  // same run as the previous N
       last_steps = steps;

@@ -21,6 +21,10 @@ struct SweepRequest {
   double t_end = 1.0;                  // nbody: the time span of every run (N counts forces over it)
 };
 
+/// The work of one run (see check_work_budget): steps x forces per step x the cost of a force of the
+/// problem and precision. Adaptive methods count the N-body cost of one force only (their steps are not known).
+double run_work_units(const RunRequest& req, const MethodDef& def);
+
 /// Runs every (method, N); N is turned into steps per period as round(N / forces_per_step).
 /// Adaptive methods run once per tolerance in `tols`; their N is the force evaluations they spent.
 std::vector<SweepRow> run_sweep(const SweepRequest& req);

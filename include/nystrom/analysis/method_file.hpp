@@ -12,7 +12,8 @@
 //   kick  0.1752673433834805 0.0576420400762506
 //   ...                              sub-steps IN THE ORDER THEY ARE APPLIED (time order); each line is
 //                                    `drift RE [IM]` (q += c h v) or `kick RE [IM]` (v += c h a(q)); numbers
-//                                    are decimals (1.5, -2e-3) or exact rationals p/q
+//                                    are decimals (1.5, -2e-3) or exact rationals p/q, at most 400
+//                                    characters each; at most 10000 sub-steps
 //
 // Validation on load (each failure is a std::invalid_argument naming the file and the line):
 //   * unknown keywords, repeated header lines, missing name/order/sub-steps, malformed or non-finite numbers;
@@ -50,6 +51,25 @@ struct MethodFile {
   std::vector<MethodFileStep> steps;
   int min_digits = 0;  // fewest significant digits among the decimal coefficients (0: all exact rationals)
 };
+
+/// Work of a BCH expansion of a splitting with `substeps` sub-steps to `degree`: sub-steps times the square of the
+/// dimension of the free Lie algebra on two letters up to that degree (each sub-step is one truncated BCH product).
+inline double bch_work(std::size_t substeps, int degree) {
+  static constexpr double cumulative_dim[] = {0, 2, 3, 5, 8, 14, 23, 41, 71, 127, 226, 412, 747};
+  const double d = cumulative_dim[std::clamp(degree, 0, 12)];
+  return static_cast<double>(substeps) * d * d;
+}
+
+/// Refuses a BCH expansion beyond bch_work_limit (about a minute on one core), naming the estimate.
+inline constexpr double bch_work_limit = 2e7;
+inline void check_bch_work(std::size_t substeps, int degree, const std::string& what) {
+  const double w = bch_work(substeps, degree);
+  if (w > bch_work_limit)
+    throw std::invalid_argument(what + ": a BCH expansion of " + std::to_string(substeps) + " sub-steps to degree " +
+                                std::to_string(degree) + " is too much work (" + std::to_string(static_cast<long>(w)) +
+                                " units, limit " + std::to_string(static_cast<long>(bch_work_limit)) +
+                                "): use fewer sub-steps or a lower degree");
+}
 
 namespace detail {
 
@@ -155,6 +175,8 @@ inline MethodFile parse_method_file(const std::string& text, const std::string& 
       for (std::string t; ns >> t;) nums.push_back(t);
       if (nums.empty() || nums.size() > 2) fail("'" + key + "' needs one or two numbers (real part, imaginary part)");
       for (const auto& t : nums) {
+        // a longer number only slows the multiprecision check down (its precision follows the digits given)
+        if (t.size() > 400) fail("a number longer than 400 characters");
         const int dg = detail::number_digits(t);
         if (dg < 0) fail("malformed number '" + t + "'");
         if (t.find('/') != std::string::npos && t.substr(t.find('/') + 1).find_first_not_of('0') == std::string::npos)
@@ -212,6 +234,7 @@ inline void validate_method_file(const MethodFile& f, const std::string& where) 
         << to_cd(sk) << "; both must be 1";
     throw std::invalid_argument(msg.str());
   }
+  check_bch_work(s.steps.size(), f.order, "method file " + where);
   AnalysisOptions opt;
   opt.degree = f.order;
   opt.precision_bits = bits;

@@ -46,9 +46,17 @@ struct MpeCoefficients {
   int order() const { return 2 * static_cast<int>(k.size()); }
 };
 
-/// Throws std::invalid_argument unless k is a non-empty set of distinct positive integers.
+/// Most products of an MPE sequence (order 400): the exact coefficients cost O(n^2) products of rationals
+/// whose size grows with n (5000 products take hours).
+inline constexpr std::size_t max_mpe_products = 200;
+
+/// Throws std::invalid_argument unless k is a non-empty set of at most max_mpe_products distinct positive
+/// integers.
 inline void validate_mpe_sequence(const std::vector<long>& k) {
   if (k.empty()) throw std::invalid_argument("MPE sequence is empty");
+  if (k.size() > max_mpe_products)
+    throw std::invalid_argument("MPE sequence has " + std::to_string(k.size()) + " members, more than " +
+                                std::to_string(max_mpe_products) + " (order 400)");
   std::set<long> seen;
   for (long x : k) {
     if (x <= 0) throw std::invalid_argument("MPE sequence members must be positive integers, got " + std::to_string(x));
@@ -90,15 +98,12 @@ inline std::vector<long> parse_sequence(const std::string& text) {
   std::stringstream ss(text);
   if (text.empty()) throw std::invalid_argument("MPE sequence is empty");
   while (std::getline(ss, item, ',')) {
-    std::size_t pos = 0;
-    long v = 0;
-    try {
-      v = std::stol(item, &pos);
-    } catch (const std::exception&) {
-      throw std::invalid_argument("malformed MPE sequence '" + text + "': '" + item + "' is not an integer");
-    }
-    if (pos != item.size()) throw std::invalid_argument("malformed MPE sequence '" + text + "': '" + item + "' is not an integer");
-    k.push_back(v);
+    // digits only (std::stol would take spaces, a sign and overflow with an exception of its own)
+    if (item.empty() || item.size() > 9 || item.find_first_not_of("0123456789") != std::string::npos)
+      throw std::invalid_argument("malformed MPE sequence: '" + item.substr(0, 40) +
+                                  "' is not a positive integer up to 1000000");
+    k.push_back(std::stol(item));
+    if (k.size() > max_mpe_products) validate_mpe_sequence(k);  // stop reading at once
   }
   if (!text.empty() && text.back() == ',') throw std::invalid_argument("malformed MPE sequence '" + text + "'");
   validate_mpe_sequence(k);
@@ -109,6 +114,8 @@ inline std::vector<long> parse_sequence(const std::string& text) {
 /// i.e. the integers closest to K/n (Chin, discussion of eq 16). Throws if K < n(n+1)/2.
 inline std::vector<long> optimal_mpe_sequence(int n, long K) {
   if (n <= 0) throw std::invalid_argument("MPE order must be positive");
+  if (static_cast<std::size_t>(n) > max_mpe_products)
+    throw std::invalid_argument("an MPE sequence has at most " + std::to_string(max_mpe_products) + " members");
   const long minimal = static_cast<long>(n) * (n + 1) / 2;
   if (K < minimal)
     throw std::invalid_argument("no " + std::to_string(n) + " distinct positive integers sum to " + std::to_string(K) +

@@ -151,8 +151,9 @@ inline LocalErrResult run_localerr(const LocalErrConfig& cfg, const std::functio
   std::vector<long> nsteps;
   for (double h : cfg.hs) {
     const double ht = h * unit;
-    const long n = std::max(1L, std::lround(duration / ht));
-    if (n > 100000000) throw std::invalid_argument("too many steps: h is too small for the duration");
+    const double steps = duration / ht;  // checked before rounding: lround of a huge value is undefined
+    if (!(steps <= 1e8)) throw std::invalid_argument("too many steps: h is too small for the duration");
+    const long n = std::max(1L, std::lround(steps));
     nsteps.push_back(n);
     total += n;
   }

@@ -116,7 +116,7 @@ NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
   if (ls.rfind("mpe-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(13)), "PV", spec);
   if (ls.rfind("mpe-pv-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(16)), "PV", spec);
   if (ls.rfind("mpe-vv-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(16)), "VV", spec);
-  if (ls.size() > 10 && ls[0] == 'm' && ls.substr(ls.size() - 9) == "-adaptive" &&
+  if (ls.size() > 10 && ls.size() < 20 && ls[0] == 'm' && ls.substr(ls.size() - 9) == "-adaptive" &&
       std::all_of(ls.begin() + 1, ls.end() - 9, ::isdigit)) {
     const long order = std::stol(ls.substr(1, ls.size() - 10));
     if (order < 4 || order % 2 != 0 || order > 400)
@@ -129,6 +129,7 @@ NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
   if (ls.rfind("mpe-pv:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(7)), "PV", spec));
   if (ls.rfind("mpe-vv:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(7)), "VV", spec));
   if (ls.size() >= 2 && ls[0] == 'm' && std::all_of(ls.begin() + 1, ls.end(), ::isdigit)) {
+    if (ls.size() > 10) throw std::invalid_argument("MPE order must be an even number between 2 and 400, got '" + spec + "'");
     const long order = std::stol(ls.substr(1));
     if (order < 2 || order % 2 != 0 || order > 400)
       throw std::invalid_argument("MPE order must be an even number between 2 and 400, got '" + spec + "'");
@@ -150,10 +151,15 @@ NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
           methods::suzuki_method(methods::parse_composition_order(spec.substr(prefix.size()), spec), base, ls));
   if (ls.rfind("file:", 0) == 0) return finalize(analysis::method_def_from_file(spec.substr(5)));  // analysis/method_file.hpp
   if (ls.rfind("adjoint:", 0) == 0) {
-    MethodDef base = resolve_method(spec.substr(8));
+    // Nested adjoints are peeled off in a loop (a recursive descent overflowed the stack at a few thousand
+    // levels); the adjoint is an involution, so only the parity of the nesting changes the method.
+    std::size_t depth = 0, pos = 0;
+    while (ls.compare(pos, 8, "adjoint:") == 0) pos += 8, ++depth;
+    MethodDef base = resolve_method(spec.substr(pos));
     auto build = base.build;
     if (!std::holds_alternative<SplittingScheme<bigcomplex>>(build()))
       throw std::invalid_argument("adjoint: is defined here for splitting methods only, not '" + base.info.name + "'");
+    if (depth % 2 == 0) return base;
     MethodDef d = base;
     d.info.name = "adjoint:" + base.info.name;
     d.info.aliases.clear();

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer harnesses of fuzz/ with clang-14 (ASan + UBSan) and runs each for a fixed time,
+# starting from the seed corpus in fuzz/corpus/<harness>/. Fails on any crash, leak, UB report, timeout or
+# out-of-memory. Environment: NYSTROM_FUZZ_SECONDS (per harness, default 30), NYSTROM_FUZZ_HARNESSES (default
+# all four), NYSTROM_FUZZ_JOBS (build jobs, default nproc). New inputs found go to build/fuzz/corpus/<harness>/,
+# never into the repository's seed corpus. docs/fuzzing.md: how to run longer and how to keep a finding.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${NYSTROM_FUZZ_SECONDS:-30}
+harnesses=${NYSTROM_FUZZ_HARNESSES:-"method_spec method_file particles cli"}
+jobs=${NYSTROM_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}
+build=build/fuzz
+san="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+
+CXX=clang++-14 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DCMAKE_CXX_FLAGS="$san -Werror" -DNYSTROM_BUILD_FUZZERS=ON -DNYSTROM_BUILD_TOOL=OFF -DNYSTROM_BUILD_TESTS=OFF \
+  -DNYSTROM_BUILD_BENCH=OFF -DNYSTROM_BUILD_EXAMPLES=OFF -DNYSTROM_PCH=OFF >/dev/null
+targets=()
+for h in $harnesses; do targets+=("fuzz_$h"); done
+cmake --build "$build" -j "$jobs" --target "${targets[@]}"
+
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+status=0
+for h in $harnesses; do
+  corpus="$build/corpus/$h"
+  mkdir -p "$corpus" "$build/findings/$h"
+  log="$build/fuzz_$h.log"
+  echo "== fuzz_$h for ${seconds} s"
+  # -timeout: one input running longer than 10 s is a finding (a hang); -rss_limit_mb: so is 2 GB of memory.
+  if "$build/fuzz_$h" "$corpus" "fuzz/corpus/$h" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      -max_len=4096 -print_final_stats=1 -artifact_prefix="$build/findings/$h/" >"$log" 2>&1; then
+    # libFuzzer's last status line: "#N DONE cov: C ft: F corp: ... exec/s: E"
+    grep -E '^#[0-9]+.*(DONE|pulse)' "$log" | tail -1 | sed 's/^/   /'
+    grep -E '^stat::number_of_executed_units|^stat::average_exec_per_sec' "$log" | sed 's/^/   /'
+  else
+    status=1
+    echo "   FAILED: fuzz_$h found a problem (input saved in $build/findings/$h/); last lines of $log:"
+    tail -30 "$log" | sed 's/^/   /'
+  fi
+done
+exit $status
