@@ -15,7 +15,7 @@ from ._solve import DenseSolution, OdeResult, solve
 from .ensemble import ensemble
 from . import problems
 
-__all__ = ["methods", "method_info", "coeffs", "solve", "OdeResult", "DenseSolution", "problems", "ensemble",
+__all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "problems", "ensemble",
            "plot"]
 
 
@@ -62,6 +62,16 @@ def coeffs(what, seq=None, order=None, n=None, sum=None, digits=20):
             raise ValueError("n and sum must both be positive")
         k = _core.optimal_mpe_sequence(int(n), int(sum))
     return _core.mpe_coeffs(k)
+
+
+def bch(method, degree=7, basis="hall", algebra="rkn", bits=192, tolerance=0.0):
+    """The BCH series of a splitting method, as ``nystrom bch --json``: the coefficients of H - Z (the
+    method's modified Hamiltonian minus the exact one) in a Lie basis for every degree up to ``degree``,
+    the algebraic order and the leading error terms (Gürkan, sec. 4). basis: "hall" or "lyndon"; algebra:
+    "rkn" (q'' = a(q): [V,[V,[T,V]]] = 0) or "free"."""
+    if not isinstance(method, str):
+        raise TypeError(f"method must be a string, got {type(method).__name__}")
+    return _core.bch(method, int(degree), str(basis), str(algebra), int(bits), float(tolerance))
 
 
 def __getattr__(name):

@@ -1,6 +1,7 @@
 // nystrom._core: the compiled part of the Python package. The catalog (methods, coeffs) and the
 // steppers the pure-Python driver (nystrom/_solve.py) advances. Library errors (std::invalid_argument)
 // reach Python as ValueError with the library's one-line message.
+#include <pybind11/complex.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -12,6 +13,7 @@
 #include <tuple>
 #include <vector>
 
+#include "nystrom/analysis/bch.hpp"
 #include "nystrom/engines/mpe.hpp"
 #include "nystrom/experiments/kepler.hpp"
 #include "nystrom/methods/catalog.hpp"
@@ -119,6 +121,66 @@ py::dict method_coeffs(const std::string& spec, int digits) {
   return j;
 }
 
+/// The BCH analysis of a splitting method, as `nystrom bch --json` gives it.
+py::dict bch(const std::string& method, int degree, const std::string& basis, const std::string& algebra,
+             unsigned bits, double tolerance) {
+  namespace an = nystrom::analysis;
+  an::check_degree(degree);
+  if (bits < 64 || bits > 4096) throw std::invalid_argument("bits must be between 64 and 4096");
+  if (!(tolerance >= 0)) throw std::invalid_argument("tolerance must be >= 0");
+  an::AnalysisOptions opt;
+  opt.degree = degree;
+  opt.basis = an::parse_basis(basis);
+  opt.algebra = an::parse_algebra(algebra);
+  opt.precision_bits = bits;
+  opt.tolerance = tolerance;
+  const an::MethodAnalysis a = an::analyze_method(resolve_method(method), opt);
+  auto terms = [](const an::DegreeTerms& d) {
+    py::list out;
+    for (const auto& t : d.terms) {
+      py::dict x;
+      x["name"] = t.name;
+      x["definition"] = t.definition;
+      x["bracket"] = t.bracket;
+      x["value"] = t.value;
+      x["exact"] = t.exact;
+      out.append(x);
+    }
+    return out;
+  };
+  py::dict j;
+  j["method"] = a.method;
+  j["degree"] = a.degree;
+  j["basis"] = an::to_string(a.basis);
+  j["algebra"] = an::to_string(a.algebra);
+  j["exact"] = a.exact;
+  j["precision_bits"] = a.precision_bits;
+  j["tolerance"] = a.tolerance;
+  j["declared_order"] = a.declared_order;
+  j["order"] = a.order;
+  j["order_is_lower_bound"] = a.order_is_lower_bound;
+  py::list degs;
+  for (const auto& d : a.degrees) {
+    py::dict x;
+    x["degree"] = d.degree;
+    x["vanishes"] = d.vanishes;
+    x["norm"] = d.norm;
+    x["terms"] = terms(d);
+    degs.append(x);
+  }
+  j["degrees"] = degs;
+  if (const auto* l = a.leading()) {
+    py::dict x;
+    x["degree"] = l->degree;
+    x["norm"] = l->norm;
+    x["terms"] = terms(*l);
+    j["leading"] = x;
+  } else {
+    j["leading"] = py::none();
+  }
+  return j;
+}
+
 /// A stepper as Python sees it; `time` is the t handed to a Python force.
 struct PyStepper {
   std::unique_ptr<Stepper> s;
@@ -181,6 +243,9 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "optimal_mpe_sequence", [](int n, long sum) { return optimal_mpe_sequence(n, sum); }, py::arg("n"),
       py::arg("sum"));
+  m.def("bch", &bch, py::arg("method"), py::arg("degree") = 7, py::arg("basis") = "hall",
+        py::arg("algebra") = "rkn", py::arg("bits") = 192u, py::arg("tolerance") = 0.0,
+        "BCH series of a splitting method: coefficients of H - Z per degree, order, leading error terms.");
   m.def("method_coeffs", &method_coeffs, py::arg("spec"), py::arg("digits") = 20,
         "The coefficients of a catalog method, as decimal strings.");
 

@@ -80,3 +80,20 @@ def test_method_coefficients_of_a_splitting_and_an_rkn():
     assert dp["family"] == "rkn" and len(dp["c"]) == 17
     with pytest.raises(ValueError):
         nystrom.coeffs("VV", digits=0)
+
+
+def test_bch_orders_and_leading_terms():
+    # Velocity Verlet: second order, its degree-3 error terms are (1/12)[T,[T,V]]-type brackets (nonzero).
+    vv = nystrom.bch("VV", degree=3)
+    assert vv["order"] == 2 and vv["exact"]
+    assert vv["leading"]["degree"] == 3 and vv["leading"]["norm"] > 0
+    assert not vv["degrees"][2]["vanishes"]
+    fr = nystrom.bch("FR", degree=5)
+    assert fr["order"] == 4 and fr["declared_order"] == 4
+    assert all(d["vanishes"] for d in fr["degrees"][:4])
+    # Symmetric methods have no even-degree terms beyond the first.
+    assert fr["degrees"][5 - 1]["vanishes"] is False
+    with pytest.raises(ValueError, match="splitting methods"):
+        nystrom.bch("DP12")
+    with pytest.raises(ValueError):
+        nystrom.bch("VV", degree=0)
