@@ -186,7 +186,18 @@ def _find_root(fn, a, b, fa, fb):
     return c
 
 
-def _accelerations(stepper, force, t, q_flat, user_shape_fn):
+def _force_row(force, t, q_row, from_flat):
+    """force(t, q) at a recorded state, as a row of the stepper's state (zero for the time coordinate)."""
+    q = from_flat(q_row)
+    r = np.asarray(force(float(t), q), dtype=float).reshape(-1)
+    if r.size != q.size:
+        raise ValueError(f"force(t, q) returned {r.size} values for a state of {q.size} coordinates")
+    out = np.zeros(len(q_row))
+    out[: r.size] = r
+    return out
+
+
+def _accelerations(stepper, force, t, q_flat, from_flat):
     """Accelerations at the recorded steps for the interpolant, and the force calls they took."""
     a = np.empty_like(q_flat)
     if force is None:
@@ -194,10 +205,7 @@ def _accelerations(stepper, force, t, q_flat, user_shape_fn):
             a[i] = stepper.acceleration(q_flat[i])
         return a, 0
     for i in range(len(t)):
-        r = np.asarray(force(float(t[i]), user_shape_fn(q_flat[i])), dtype=float)
-        if r.size != q_flat.shape[1]:
-            raise ValueError(f"force(t, q) returned {r.size} values for a state of {q_flat.shape[1]} coordinates")
-        a[i] = r.reshape(-1)
+        a[i] = _force_row(force, t[i], q_flat[i], from_flat)
     return a, len(t)
 
 
@@ -209,10 +217,9 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     Parameters
     ----------
     force : callable or nystrom.problems.Problem
-        ``force(t, q) -> array`` shaped like ``q`` (called once per force evaluation; exceptions propagate
-        unchanged), or a built-in problem (runs entirely in C++ with the GIL released). nystrom integrates
-        autonomous systems: ``t`` is the start time of the current advance, not the time of the stage;
-        make a time-dependent force autonomous by adding time as a coordinate (``q_t'' = 0``, ``v_t = 1``).
+        ``force(t, q) -> array`` shaped like ``q`` (called once per force evaluation with the time of the
+        stage; exceptions propagate unchanged), or a built-in problem (runs entirely in C++ with the GIL
+        released). The time is integrated as one more coordinate (velocity 1), exactly by every method.
     q0, v0 : array_like
         Initial positions and velocities (any shape, the same for both). Default for a built-in problem:
         its initial state.
@@ -274,8 +281,10 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         q0 = _state("q0", q0)
         v0 = _state("v0", v0, q0.shape)
         user_shape = q0.shape
+        n_user = q0.size
         to_flat = lambda x: np.ascontiguousarray(x, dtype=float).reshape(-1)  # noqa: E731
-        from_flat = lambda x: np.asarray(x).reshape(user_shape)  # noqa: E731
+        # The stepper's state carries the time as one more coordinate (the last), stripped here.
+        from_flat = lambda x: np.asarray(x)[:n_user].reshape(user_shape)  # noqa: E731
         py_force = force
         if precision != "double":
             raise ValueError(f"precision '{precision}' is available for built-in problems only; "
@@ -326,7 +335,13 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
                                         precision=precision, **common)
     else:
         stepper = _core.python_stepper(py_force, list(user_shape), method, **common)
-    stepper.set_state(to_flat(q0), to_flat(v0))
+    if py_force is None:
+        def state_row(x, t_value, is_velocity):
+            return to_flat(x)
+    else:
+        def state_row(x, t_value, is_velocity):
+            return np.append(to_flat(x), 1.0 if is_velocity else t_value)
+    stepper.set_state(state_row(q0, t0, False), state_row(v0, t0, True))
 
     bar = make_progress(progress, t0, t1)
     beat = None if bar is None else bar.update
@@ -430,8 +445,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         ot, oq, ov = ot[keep], oq[keep], ov[keep]
         ev_i = stop_at[1]
         ot = np.append(ot, ev_t[ev_i][-1])
-        oq = np.vstack([oq, to_flat(ev_q[ev_i][-1])[None, :]])
-        ov = np.vstack([ov, to_flat(ev_v[ev_i][-1])[None, :]])
+        oq = np.vstack([oq, state_row(ev_q[ev_i][-1], ot[-1], False)[None, :]])
+        ov = np.vstack([ov, state_row(ev_v[ev_i][-1], ot[-1], True)[None, :]])
     res = OdeResult()
     res.t = ot
     res.q = np.stack([from_flat(x) for x in oq]) if len(ot) else np.empty((0,) + tuple(user_shape))
@@ -451,8 +466,9 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.precision = precision
     res.h = h_used
     strs = stepper.state_strings()
-    res.q_str = strs[: len(strs) // 2]
-    res.v_str = strs[len(strs) // 2:]
+    half, n_coords = len(strs) // 2, int(np.prod(user_shape))
+    res.q_str = strs[:n_coords]
+    res.v_str = strs[half:half + n_coords]
     return res
 
 
@@ -469,7 +485,7 @@ def _scan_events(events, step_t, step_q, step_v, start, stepper, py_force, from_
             if py_force is None:
                 accel_cache[i] = stepper.acceleration(step_q[i])
             else:
-                accel_cache[i] = np.asarray(py_force(step_t[i], from_flat(step_q[i])), dtype=float).reshape(-1)
+                accel_cache[i] = _force_row(py_force, step_t[i], step_q[i], from_flat)
         return accel_cache[i]
 
     g_prev = [float(e(step_t[start], from_flat(step_q[start]), from_flat(step_v[start]))) for e in events]

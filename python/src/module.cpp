@@ -181,10 +181,9 @@ py::dict bch(const std::string& method, int degree, const std::string& basis, co
   return j;
 }
 
-/// A stepper as Python sees it; `time` is the t handed to a Python force.
+/// A stepper as Python sees it.
 struct PyStepper {
   std::unique_ptr<Stepper> s;
-  std::shared_ptr<double> time = std::make_shared<double>(0.0);
 };
 
 using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
@@ -283,7 +282,6 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("adaptive", [](const PyStepper& p) { return p.s->adaptive(); })
       .def_property_readonly("python_force", [](const PyStepper& p) { return p.s->python_force(); })
       .def_property_readonly("force_evals", [](const PyStepper& p) { return p.s->force_evals(); })
-      .def("set_time", [](PyStepper& p, double t) { *p.time = t; })
       .def("set_state",
            [](PyStepper& p, const DArray& q, const DArray& v) {
              const std::size_t n = p.s->dim();
@@ -311,7 +309,6 @@ PYBIND11_MODULE(_core, m) {
             Record* r = every > 0 ? &rec : nullptr;
             Heartbeat hb{std::move(progress), !p.s->python_force()};
             AdvanceStatus st;
-            *p.time = t0;
             if (hb.release_gil) {
               py::gil_scoped_release free;
               st = p.s->advance_fixed(t0, t1, n, every, r, hb);
@@ -328,7 +325,6 @@ PYBIND11_MODULE(_core, m) {
             Record* r = record ? &rec : nullptr;
             Heartbeat hb{std::move(progress), !p.s->python_force()};
             AdvanceStatus st;
-            *p.time = t0;
             if (hb.release_gil) {
               py::gil_scoped_release free;
               st = p.s->advance_adaptive(t0, t1, r, hb);
@@ -364,7 +360,8 @@ PYBIND11_MODULE(_core, m) {
         std::size_t n = 1;
         for (auto s : shape) n *= static_cast<std::size_t>(s);
         PyStepper p;
-        p.s = make_python_stepper(std::move(fn), std::move(shape), n, def, o, p.time);
+        std::shared_ptr<double> time_slot;  // the force's time, set by the stepper at every stage
+        p.s = make_python_stepper(std::move(fn), std::move(shape), n, def, o, time_slot);
         return p;
       },
       py::arg("force"), py::arg("shape"), py::arg("method"), py::arg("tol") = 0.0, py::arg("h0") = 0.0,

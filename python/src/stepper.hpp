@@ -147,8 +147,8 @@ struct HenonHeilesForce {
 };
 
 /// A Python callable force(t, q) -> array, called once per force evaluation with q shaped like the
-/// user's q0. The library integrates autonomous systems q'' = a(q): t is the start time of the current
-/// advance (see the documentation of nystrom.solve). Exceptions raised by the callable propagate
+/// user's q0 and the time in the slot t (set per stage from the time coordinate, stepper_python.cpp).
+/// Exceptions raised by the callable propagate
 /// unchanged (py::error_already_set carries the original Python exception through the engine).
 template <class S>
 struct PyForce {

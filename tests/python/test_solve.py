@@ -233,3 +233,38 @@ def test_extended_precision_beyond_double():
     assert max(abs(a - b) for a, b in zip(ld, qd)) < Decimal("1e-16")
     assert max(abs(a - b) for a, b in zip(ld, qd)) < max(abs(a - b) for a, b in zip(dbl, qd)) / 8
     assert np.allclose(runs["double"].q, runs["qd"].q, atol=1e-14)
+
+
+def forced_oscillator(t, q):
+    return -q + np.cos(2 * t)
+
+
+def forced_exact(t):
+    # q'' + q = cos 2t, q(0) = 1, q'(0) = 0: q = (4/3) cos t - (1/3) cos 2t.
+    return 4 / 3 * np.cos(t) - np.cos(2 * t) / 3
+
+
+@pytest.mark.parametrize("method,order,n1", [("FR", 4, 100), ("M6", 6, 40), ("A6", 6, 40)])
+def test_time_dependent_force_gets_the_stage_time(method, order, n1):
+    errs = []
+    for n in (n1, 2 * n1):
+        res = nystrom.solve(forced_oscillator, [1.0], [0.0], t_span=(0, 3.0), method=method, steps=n, t_eval=[3.0])
+        errs.append(abs(res.q[-1, 0] - forced_exact(3.0)))
+    p = math.log2(errs[0] / errs[1])
+    assert abs(p - order) <= 0.35, (method, p, errs)
+
+
+def test_time_dependent_force_adaptive_and_dense():
+    res = nystrom.solve(forced_oscillator, [1.0], [0.0], t_span=(0, 3.0), method="DP12-adaptive", rtol=1e-12,
+                        dense_output=True)
+    assert abs(res.q[-1, 0] - forced_exact(3.0)) < 1e-9
+    # At the steps the interpolant is the computed solution; between them its error is O(h^6), large for
+    # the long steps of a twelfth-order method, small for short fixed steps.
+    q, _ = res.sol(res.t)
+    assert np.array_equal(q, res.q)
+    q, _ = res.sol(1.2345)
+    assert abs(q[0] - forced_exact(1.2345)) < 1e-4
+    fixed = nystrom.solve(forced_oscillator, [1.0], [0.0], t_span=(0, 3.0), method="M8", h=0.05, dense_output=True)
+    q, _ = fixed.sol(1.2345)
+    assert abs(q[0] - forced_exact(1.2345)) < 1e-8
+    assert len(res.q_str) == 1 and float(res.q_str[0]) == pytest.approx(res.q[-1, 0], rel=1e-15)
