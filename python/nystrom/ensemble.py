@@ -1,5 +1,6 @@
 """Ensembles: one integration per parameter, mapped over any concurrent.futures-style executor."""
 
+import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor
 
@@ -33,7 +34,7 @@ def ensemble(problem_factory, parameters, method="M8", executor=None, max_worker
     executor: any object with ``submit(fn, *args)`` returning futures with ``result()``:
     ``concurrent.futures.ProcessPoolExecutor``/``ThreadPoolExecutor``, a ``dask.distributed.Client``, an
     ``mpi4py.futures.MPIPoolExecutor``. None: a local process pool of ``max_workers`` processes (default:
-    the number of CPUs), closed afterwards. Every run is deterministic, so the results are the same
+    the number of CPUs; started with spawn), closed afterwards. Every run is deterministic, so the results are the same
     whatever executor runs them.
     """
     params = list(parameters)
@@ -45,7 +46,9 @@ def ensemble(problem_factory, parameters, method="M8", executor=None, max_worker
         return []
     if executor is None:
         workers = max_workers or min(len(params), os.cpu_count() or 1)
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        # spawn, not fork: a forked child inherits the parent's OpenMP runtime (the N-body force), which
+        # is not safe to use after fork.
+        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
             futures = [pool.submit(_run_one, problem_factory, p, method, solve_kwargs) for p in params]
             return [f.result() for f in futures]
     futures = [executor.submit(_run_one, problem_factory, p, method, solve_kwargs) for p in params]
