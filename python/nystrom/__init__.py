@@ -1,0 +1,83 @@
+"""nystrom: high-order splitting, Runge-Kutta-Nyström and multi-product integrators for q'' = a(q).
+
+    import numpy as np, nystrom
+    res = nystrom.solve(lambda t, q: -q / np.linalg.norm(q) ** 3, [1.9, 0.0], [0.0, 0.2294157338705618],
+                        t_span=(0, 20 * np.pi), method="M8", steps=20000)
+    res.q[-1], res.force_evals
+
+Built-in problems (``nystrom.problems``) run in C++ with the GIL released; ``nystrom.ensemble`` maps runs
+over a process pool, a Dask client or an MPI pool; ``nystrom.plot`` draws orbits, energy errors and
+work-precision charts.
+"""
+
+from . import _core
+from ._solve import DenseSolution, OdeResult, solve
+from .ensemble import ensemble
+from . import problems
+
+__all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "problems", "ensemble",
+           "plot"]
+
+
+def methods():
+    """The catalog: one dict per method with name, family, order, stages, forces_per_step, fsal,
+    symmetric, symplectic, complex, adaptive, published_digits, aliases, source, description."""
+    return _core.methods()
+
+
+def method_info(spec):
+    """The catalog record of a method specification: a name or alias, ``M<2n>``, ``mpe:1,2,3``,
+    ``mpe-vv:1,2,3``, ``M<2n>-adaptive``, ``adjoint:NAME``, ``triplejump:P``, ``suzuki:P``, ..."""
+    if not isinstance(spec, str):
+        raise TypeError(f"method must be a string, got {type(spec).__name__}")
+    return _core.method_info(spec)
+
+
+def coeffs(what, seq=None, order=None, n=None, sum=None, digits=20):
+    """Coefficients, as ``nystrom coeffs`` prints them with --json.
+
+    ``coeffs("Yoshida6")``: any method's table (splitting sub-steps, RKN tableau or MPE sequence), decimals
+    with ``digits`` digits; ``coeffs("mpe", seq=[1, 2, 3])``, ``coeffs("mpe", order=8)`` or
+    ``coeffs("mpe", n=4, sum=12)``: exact multi-product coefficients (Chin eqs 14-15) as rational strings.
+    """
+    if not isinstance(what, str):
+        raise TypeError(f"what must be a string, got {type(what).__name__}")
+    if what != "mpe":
+        if seq is not None or order is not None or n is not None or sum is not None:
+            raise ValueError("seq, order, n and sum apply to coeffs('mpe', ...) only")
+        return _core.method_coeffs(what, int(digits))
+    given = (seq is not None) + (order is not None) + (n is not None or sum is not None)
+    if given != 1:
+        raise ValueError("coeffs('mpe') needs exactly one of seq, order, or n with sum")
+    if seq is not None:
+        k = [int(x) for x in seq]
+    elif order is not None:
+        if int(order) != order or order < 2 or order % 2:
+            raise ValueError("order must be a positive even number")
+        if order > 400:
+            raise ValueError("order must be at most 400")
+        k = list(range(1, order // 2 + 1))
+    else:
+        if n is None or sum is None or n <= 0 or sum <= 0:
+            raise ValueError("n and sum must both be positive")
+        k = _core.optimal_mpe_sequence(int(n), int(sum))
+    return _core.mpe_coeffs(k)
+
+
+def bch(method, degree=7, basis="hall", algebra="rkn", bits=192, tolerance=0.0):
+    """The BCH series of a splitting method, as ``nystrom bch --json``: the coefficients of H - Z (the
+    method's modified Hamiltonian minus the exact one) in a Lie basis for every degree up to ``degree``,
+    the algebraic order and the leading error terms (Gürkan, sec. 4). basis: "hall" or "lyndon"; algebra:
+    "rkn" (q'' = a(q): [V,[V,[T,V]]] = 0) or "free"."""
+    if not isinstance(method, str):
+        raise TypeError(f"method must be a string, got {type(method).__name__}")
+    return _core.bch(method, int(degree), str(basis), str(algebra), int(bits), float(tolerance))
+
+
+def __getattr__(name):
+    # matplotlib is imported only when plotting is asked for.
+    if name == "plot":
+        import importlib
+
+        return importlib.import_module(".plot", __name__)
+    raise AttributeError(f"module 'nystrom' has no attribute {name!r}")

@@ -1,0 +1,131 @@
+"""Bad input gets ValueError/TypeError with a one-line message; exceptions of the force propagate unchanged."""
+import math
+
+import numpy as np
+import pytest
+
+import nystrom
+from nystrom.problems import Kepler, NBody
+
+
+def f(t, q):
+    return -q
+
+
+def one_line(exc):
+    msg = str(exc.value)
+    assert msg and "\n" not in msg
+    return msg
+
+
+@pytest.mark.parametrize("kwargs,exc,match", [
+    (dict(q0=[1.0, 0.0], v0=[0.0]), ValueError, "shape"),
+    (dict(q0=[1.0, np.nan], v0=[0.0, 1.0]), ValueError, "NaN"),
+    (dict(q0=[1.0, 0.0], v0=[0.0, np.inf]), ValueError, "NaN or infinite"),
+    (dict(q0=[], v0=[]), ValueError, "empty"),
+    (dict(q0=["a"], v0=[0.0]), TypeError, "real numbers"),
+    (dict(q0=[1j], v0=[0.0]), TypeError, "real numbers"),
+    (dict(method="NoSuchMethod"), ValueError, "unknown method"),
+    (dict(method=3), TypeError, "method"),
+    (dict(rtol=-1.0, method="M8"), ValueError, "rtol"),
+    (dict(rtol=math.nan, method="M8"), ValueError, "rtol"),
+    (dict(atol=0.0, method="M8"), ValueError, "atol"),
+    (dict(rtol="x", method="M8"), TypeError, "rtol"),
+    (dict(h=0.1, steps=10), ValueError, "either h or steps"),
+    (dict(h=-0.1), ValueError, "h must be positive"),
+    (dict(steps=0), ValueError, "steps"),
+    (dict(steps=10, rtol=1e-8), ValueError, "exclude"),
+    (dict(method="FR"), ValueError, "fixed steps"),
+    (dict(method="FR", rtol=1e-8), ValueError, ""),
+    (dict(t_span=(1.0, 0.0)), ValueError, "increasing"),
+    (dict(t_span=(0.0, math.inf)), ValueError, "finite"),
+    (dict(t_span=5), ValueError, "pair"),
+    (dict(t_eval=[0.5, 0.2]), ValueError, "increasing"),
+    (dict(t_eval=[2.0]), ValueError, "inside t_span"),
+    (dict(precision="dd"), ValueError, "built-in problems"),
+    (dict(method="Chambers", rtol=1e-8), ValueError, "real coefficients"),
+    (dict(progress="yes"), TypeError, "progress"),
+])
+def test_bad_arguments(kwargs, exc, match):
+    args = dict(q0=[1.0, 0.0], v0=[0.0, 1.0], t_span=(0.0, 1.0), method="M8", steps=10)
+    if "rtol" in kwargs or "atol" in kwargs or "h" in kwargs:
+        args.pop("steps")
+    if kwargs.get("method") == "FR" and "rtol" not in kwargs:
+        args.pop("steps")
+    args.update(kwargs)
+    with pytest.raises(exc, match=match) as e:
+        nystrom.solve(f, **args)
+    one_line(e)
+
+
+def test_force_returning_the_wrong_shape_or_type():
+    with pytest.raises(ValueError, match="returned 3 values for a state of 2") as e:
+        nystrom.solve(lambda t, q: np.zeros(3), [1.0, 0.0], [0.0, 1.0], t_span=(0, 1), steps=10)
+    one_line(e)
+    with pytest.raises(TypeError, match="array of numbers"):
+        nystrom.solve(lambda t, q: None, [1.0, 0.0], [0.0, 1.0], t_span=(0, 1), steps=10)
+    with pytest.raises((TypeError, ValueError)):
+        nystrom.solve(lambda t, q: "ab", [1.0, 0.0], [0.0, 1.0], t_span=(0, 1), steps=10)
+
+
+class Boom(Exception):
+    pass
+
+
+def test_force_exception_propagates_unchanged():
+    calls = [0]
+    err = Boom("from the force")
+
+    def force(t, q):
+        calls[0] += 1
+        if calls[0] == 7:
+            raise err
+        return -q
+
+    for kw in (dict(steps=100), dict(rtol=1e-8)):
+        calls[0] = 0
+        with pytest.raises(Boom) as e:
+            nystrom.solve(force, [1.0], [0.0], t_span=(0, 1), method="M8", **kw)
+        assert e.value is err
+        assert calls[0] == 7
+
+
+def test_nan_during_the_integration_is_reported():
+    # a = q^3 blows up in finite time: the run stops with status -1 and a message, no garbage.
+    res = nystrom.solve(lambda t, q: q ** 3 * 1e3, [10.0], [10.0], t_span=(0, 10.0), method="FR", steps=1000)
+    assert res.status == -1 and not res.success
+    assert "NaN" in res.message
+
+
+def test_adaptive_failure_is_reported_in_status():
+    # An orbit that falls into the centre (zero angular momentum): the step size underflows.
+    res = nystrom.solve(Kepler(0.0), q0=[1.0, 0.0], v0=[0.0, 0.0], t_span=(0, 10.0), method="DP12-adaptive",
+                        rtol=1e-12)
+    assert res.status == -1 and "underflow" in res.message
+
+
+def test_problem_arguments():
+    with pytest.raises(ValueError, match="eccentricity"):
+        Kepler(1.0)
+    with pytest.raises(TypeError):
+        Kepler("0.5")
+    sim = NBody()
+    with pytest.raises(ValueError, match="no particles"):
+        nystrom.solve(sim, t_span=(0, 1), steps=10)
+    with pytest.raises(ValueError, match="mass"):
+        sim.add(m=-1.0)
+    with pytest.raises(ValueError, match="shape"):
+        nystrom.solve(Kepler(0.5), q0=[1.0, 0.0, 0.0], t_span=(0, 1), steps=10)
+    with pytest.raises(ValueError, match="long-double, float128"):
+        nystrom.solve(Kepler(0.5), t_span=(0, 1), steps=10, precision="mpfr:200")
+    with pytest.raises(ValueError, match="unknown precision"):
+        nystrom.solve(Kepler(0.5), t_span=(0, 1), steps=10, precision="octuple")
+    with pytest.raises(TypeError, match="force must be"):
+        nystrom.solve(42, [1.0], [0.0], t_span=(0, 1), steps=10)
+
+
+def test_coeffs_errors():
+    with pytest.raises(ValueError, match="unknown method"):
+        nystrom.coeffs("NoSuchMethod")
+    with pytest.raises(ValueError):
+        nystrom.coeffs("VV", seq=[1, 2])

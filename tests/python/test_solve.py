@@ -1,0 +1,270 @@
+"""nystrom.solve with Python forces and built-in problems: orders, adaptivity, output times, dense output,
+events, extended precision."""
+import math
+
+import numpy as np
+import pytest
+
+import nystrom
+from nystrom.problems import HarmonicOscillator, HenonHeiles, Kepler
+
+E = 0.5
+T_END = 3.7  # not a multiple of the period (whole periods can show one order more, see the order test)
+
+
+def kepler_force(t, q):
+    return -q / np.dot(q, q) ** 1.5
+
+
+def kepler_error(res, prob):
+    qx, _ = prob.exact(res.t[-1])
+    return float(np.linalg.norm(res.q[-1] - qx))
+
+
+def observed_order(method, n1, force=None, precision="double"):
+    prob = Kepler(E)
+    errs = []
+    if precision != "double":  # the reference: M16 in quad-double with small steps (error far below dd's)
+        from decimal import Decimal, getcontext
+
+        getcontext().prec = 80
+        ref = nystrom.solve(prob, t_span=(0, T_END), method="M16", steps=400, precision="qd", t_eval=[T_END])
+        ref = [Decimal(x) for x in ref.q_str]
+    for n in (n1, 2 * n1):
+        if force is None:
+            res = nystrom.solve(prob, t_span=(0, T_END), method=method, steps=n, t_eval=[T_END], precision=precision)
+        else:
+            res = nystrom.solve(force, prob.q0, prob.v0, t_span=(0, T_END), method=method, steps=n, t_eval=[T_END])
+        assert res.success
+        if precision == "double":
+            errs.append(kepler_error(res, prob))
+        else:
+            errs.append(float(max(abs(Decimal(a) - b) for a, b in zip(res.q_str, ref))))
+    return math.log2(errs[0] / errs[1]), errs
+
+
+# (method, declared order, steps of the coarser run): one or two methods of each family, step counts in the
+# asymptotic range of Kepler at e = 0.5 over t = 3.7, and errors well above rounding.
+ORDER_CASES = [
+    ("VV", 2, 200),
+    ("FR", 4, 200),
+    ("Yoshida6", 6, 100),
+    ("N4", 4, 100),
+    ("A6", 6, 100),
+    ("M4", 4, 100),
+    ("M8", 8, 40),
+]
+
+
+@pytest.mark.parametrize("method,order,n1", ORDER_CASES)
+def test_observed_order_with_a_python_force(method, order, n1):
+    p, errs = observed_order(method, n1, kepler_force)
+    assert abs(p - order) <= 0.35, f"{method}: observed order {p:.2f} (errors {errs})"
+
+
+# The tenth- and twelfth-order RKN methods reach their asymptotic range only below double's rounding: measured
+# in double-double.
+@pytest.mark.parametrize("method,order,n1,precision", [("FR", 4, 200, "double"), ("M6", 6, 60, "double"),
+                                                       ("DP10", 10, 64, "dd"), ("DP12", 12, 64, "dd")])
+def test_observed_order_with_the_built_in_force(method, order, n1, precision):
+    p, errs = observed_order(method, n1, precision=precision)
+    assert abs(p - order) <= 0.35, f"{method}: observed order {p:.2f} (errors {errs})"
+
+
+def test_python_and_built_in_forces_agree():
+    prob = Kepler(0.7)
+    a = nystrom.solve(prob, t_span=(0, 10.0), method="M8", steps=500)
+    b = nystrom.solve(kepler_force, prob.q0, prob.v0, t_span=(0, 10.0), method="M8", steps=500)
+    assert a.force_evals == b.force_evals
+    # M8 on position Verlet: 1 + 2 + 3 + 4 = 10 forces per step.
+    assert a.force_evals == 10 * 500
+    assert np.allclose(a.q, b.q, rtol=0, atol=1e-11)
+    assert a.t.shape == (501,) and a.q.shape == (501, 2) and a.v.shape == (501, 2)
+    assert a.t[-1] == 10.0
+
+
+def test_force_evaluation_count_equals_python_calls():
+    calls = [0]
+
+    def f(t, q):
+        calls[0] += 1
+        return -q
+
+    res = nystrom.solve(f, [1.0], [0.0], t_span=(0, 1.0), method="FR", steps=50, t_eval=[1.0])
+    assert res.force_evals == calls[0]
+
+
+def test_complex_coefficient_method_from_python():
+    prob = HarmonicOscillator()
+    res = nystrom.solve(lambda t, q: -q, prob.q0, prob.v0, t_span=(0, 2.0), method="Chambers", steps=400,
+                        t_eval=[2.0])
+    qx, _ = prob.exact(2.0)
+    assert abs(res.q[-1, 0] - qx[0]) < 1e-6
+
+
+def test_adaptive_methods_reach_their_tolerance():
+    prob = Kepler(0.9)
+    t1 = 2 * math.pi * 3 + 1.0
+    for method, tol in (("DP12-adaptive", 1e-10), ("M10", 1e-10)):
+        res = nystrom.solve(prob, t_span=(0, t1), method=method, rtol=tol, t_eval=[t1])
+        assert res.success and res.steps > 10
+        err = kepler_error(res, prob)
+        assert err < 1e4 * tol, (method, err)
+        tighter = nystrom.solve(prob, t_span=(0, t1), method=method, rtol=tol * 1e-3, t_eval=[t1])
+        assert kepler_error(tighter, prob) < err
+        assert tighter.force_evals > res.force_evals
+
+
+def test_t_eval_lands_on_each_time():
+    prob = Kepler(0.3)
+    te = np.linspace(0.5, 9.5, 7)
+    for kw in (dict(h=0.01), dict(rtol=1e-11)):
+        res = nystrom.solve(prob, t_span=(0, 10.0), method="M10", t_eval=te, **kw)
+        assert np.array_equal(res.t, te)
+        qx, vx = prob.exact(te)
+        assert np.max(np.abs(res.q - qx)) < 1e-8
+        assert np.max(np.abs(res.v - vx)) < 1e-8
+
+
+def test_dense_output_interpolates_with_sixth_order():
+    # Quintic Hermite through exact-to-rounding nodes (M16, tiny method error): the interpolation error at
+    # mid-step points falls as h^6.
+    prob = HarmonicOscillator()
+    errs = []
+    for n in (20, 40):
+        res = nystrom.solve(lambda t, q: -q, prob.q0, prob.v0, t_span=(0, 4.0), method="M16", steps=n,
+                            dense_output=True)
+        mids = 0.5 * (res.t[:-1] + res.t[1:])
+        q, v = res.sol(mids)
+        qx, vx = prob.exact(mids)
+        errs.append(np.max(np.abs(q - qx)))
+        assert res.interpolant_force_evals == n + 1
+        assert np.max(np.abs(v - vx)) < 50 * errs[-1] * n
+    p = math.log2(errs[0] / errs[1])
+    assert abs(p - 6) <= 0.35, (p, errs)
+    q, v = res.sol(1.234)
+    assert q.shape == (1,) and v.shape == (1,)
+    with pytest.raises(ValueError):
+        res.sol(5.0)
+
+
+def test_terminal_event_at_pericentre():
+    # From apocentre (1+e, 0) moving counter-clockwise, y falls through zero at pericentre, t = pi.
+    prob = Kepler(E)
+
+    def y_falls(t, q, v):
+        return q[1]
+
+    y_falls.terminal = True
+    y_falls.direction = -1
+    for kw in (dict(h=0.01), dict(rtol=1e-12)):
+        res = nystrom.solve(prob, t_span=(0, 10.0), method="M8", events=y_falls, **kw)
+        assert res.status == 1
+        assert res.t_events[0][0] == pytest.approx(math.pi, abs=1e-9)
+        assert res.t[-1] == res.t_events[0][0]
+        assert np.allclose(res.q_events[0][0], [-(1 - E), 0.0], atol=1e-9)
+
+
+def test_non_terminal_events_count_crossings():
+    prob = Kepler(E)
+
+    def y_zero(t, q, v):
+        return q[1]
+
+    res = nystrom.solve(kepler_force, prob.q0, prob.v0, t_span=(0, 4 * math.pi + 1.0), method="M8", h=0.02,
+                        events=[y_zero])
+    assert res.status == 0
+    # Zeros of y at t = pi, 2 pi, 3 pi, 4 pi (t = 0 itself is the start, not a crossing).
+    assert np.allclose(res.t_events[0], [math.pi, 2 * math.pi, 3 * math.pi, 4 * math.pi], atol=1e-9)
+
+
+def test_energy_of_henon_heiles_is_conserved_by_a_symplectic_method():
+    prob = HenonHeiles()
+    res = nystrom.solve(prob, t_span=(0, 200.0), method="Yoshida6", h=0.05)
+    E0 = prob.energy(prob.q0, prob.v0)
+    drift = np.max(np.abs(prob.energy(res.q, res.v) - E0))
+    assert drift < 1e-7
+
+
+def test_nbody_two_body_orbit_matches_kepler():
+    # Two bodies of mass 1/2 with relative orbit = Kepler(e): their separation follows the Kepler solution.
+    e = 0.4
+    k = Kepler(e)
+    sim = nystrom.problems.NBody(G=1.0)
+    rx, vy = k.q0[0], k.v0[1]
+    sim.add(m=0.5, x=-rx / 2, vy=-vy / 2)
+    sim.add(m=0.5, x=rx / 2, vy=vy / 2)
+    res = nystrom.solve(sim, t_span=(0, T_END), method="M8", steps=400, t_eval=[T_END])
+    rel = res.q[-1, 1, :2] - res.q[-1, 0, :2]
+    qx, _ = k.exact(T_END)
+    assert np.linalg.norm(rel - qx) < 1e-10
+    assert res.q.shape == (1, 2, 3)
+
+
+def test_plummer_sphere_energy():
+    p = nystrom.problems.Plummer(32, seed=7, eps=0.0)
+    assert p.N == 32
+    # Standard units: E = -1/4 (the sample is rescaled to it), total mass 1.
+    assert p.energy(p.q0, p.v0) == pytest.approx(-0.25, rel=1e-12)
+    assert sum(p.masses) == pytest.approx(1.0)
+    soft = nystrom.problems.Plummer(32, seed=7)
+    res = nystrom.solve(soft, t_span=(0, 0.5), method="M6", h=1e-3, t_eval=[0.5])
+    assert abs(soft.energy(res.q[-1], res.v[-1]) / soft.energy(soft.q0, soft.v0) - 1) < 1e-9
+
+
+def test_extended_precision_beyond_double():
+    prob = Kepler(0.2)
+    runs = {p: nystrom.solve(prob, t_span=(0, 1.0), method="M16", steps=64, precision=p, t_eval=[1.0])
+            for p in ("double", "long-double", "dd", "qd", "float128")}
+    from decimal import Decimal, getcontext
+
+    getcontext().prec = 80
+    dd = [Decimal(s) for s in runs["dd"].q_str]
+    qd = [Decimal(s) for s in runs["qd"].q_str]
+    f128 = [Decimal(s) for s in runs["float128"].q_str]
+    # M16 at h = 1/64 on a smooth orbit: truncation error far below 1e-26; dd (106 bits), float128 (113)
+    # and qd (212) agree to their rounding level; double does not.
+    assert max(abs(a - b) for a, b in zip(dd, qd)) < Decimal("1e-26")
+    assert max(abs(a - b) for a, b in zip(f128, qd)) < Decimal("1e-27")
+    assert len(runs["qd"].q_str[0].replace("-", "").replace(".", "")) > 50
+    ld = [Decimal(s) for s in runs["long-double"].q_str]
+    dbl = [Decimal(s) for s in runs["double"].q_str]
+    # long double (64 bits) lands between double (53) and dd.
+    assert max(abs(a - b) for a, b in zip(ld, qd)) < Decimal("1e-16")
+    assert max(abs(a - b) for a, b in zip(ld, qd)) < max(abs(a - b) for a, b in zip(dbl, qd)) / 8
+    assert np.allclose(runs["double"].q, runs["qd"].q, atol=1e-14)
+
+
+def forced_oscillator(t, q):
+    return -q + np.cos(2 * t)
+
+
+def forced_exact(t):
+    # q'' + q = cos 2t, q(0) = 1, q'(0) = 0: q = (4/3) cos t - (1/3) cos 2t.
+    return 4 / 3 * np.cos(t) - np.cos(2 * t) / 3
+
+
+@pytest.mark.parametrize("method,order,n1", [("FR", 4, 100), ("M6", 6, 40), ("A6", 6, 40)])
+def test_time_dependent_force_gets_the_stage_time(method, order, n1):
+    errs = []
+    for n in (n1, 2 * n1):
+        res = nystrom.solve(forced_oscillator, [1.0], [0.0], t_span=(0, 3.0), method=method, steps=n, t_eval=[3.0])
+        errs.append(abs(res.q[-1, 0] - forced_exact(3.0)))
+    p = math.log2(errs[0] / errs[1])
+    assert abs(p - order) <= 0.35, (method, p, errs)
+
+
+def test_time_dependent_force_adaptive_and_dense():
+    res = nystrom.solve(forced_oscillator, [1.0], [0.0], t_span=(0, 3.0), method="DP12-adaptive", rtol=1e-12,
+                        dense_output=True)
+    assert abs(res.q[-1, 0] - forced_exact(3.0)) < 1e-9
+    # At the steps the interpolant is the computed solution; between them its error is O(h^6), large for
+    # the long steps of a twelfth-order method, small for short fixed steps.
+    q, _ = res.sol(res.t)
+    assert np.array_equal(q, res.q)
+    q, _ = res.sol(1.2345)
+    assert abs(q[0] - forced_exact(1.2345)) < 1e-4
+    fixed = nystrom.solve(forced_oscillator, [1.0], [0.0], t_span=(0, 3.0), method="M8", h=0.05, dense_output=True)
+    q, _ = fixed.sol(1.2345)
+    assert abs(q[0] - forced_exact(1.2345)) < 1e-8
+    assert len(res.q_str) == 1 and float(res.q_str[0]) == pytest.approx(res.q[-1, 0], rel=1e-15)
