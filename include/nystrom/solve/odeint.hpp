@@ -47,7 +47,7 @@ class OdeintStepper {
   }
 
   order_type order() const { return static_cast<order_type>(def_.info.order); }
-  long force_evals() const { return cache_ ? cache_->force_evals() : 0; }
+  long force_evals() const { return *cache_ ? (*cache_)->force_evals() : 0; }
 
   /// One step of size dt from the state (q, p) in place; t is not used (the force is autonomous).
   template <class System, class StateInOut>
@@ -94,12 +94,13 @@ class OdeintStepper {
   template <class System>
   void step(System& system, V& q, V& p, time_type dt) {
     if (q.size() != p.size()) throw invalid_input("inconsistent state: q and p differ in size");
-    if (!cache_ || *cache_->type != typeid(System)) {
+    auto& slot = *cache_;
+    if (!slot || *slot->type != typeid(System)) {
       auto h = std::make_shared<TypedHolder<System>>(def_, opt_);
       h->type = &typeid(System);
-      cache_ = h;
+      slot = h;
     }
-    auto& integ = static_cast<TypedHolder<System>&>(*cache_).integ;
+    auto& integ = static_cast<TypedHolder<System>&>(*slot).integ;
     integ.force().sys = &system;
     State<V> s{std::move(q), std::move(p)};
     integ.integrate(s, dt, 1);
@@ -109,7 +110,9 @@ class OdeintStepper {
 
   MethodDef def_;
   EngineOptions opt_;
-  std::shared_ptr<Holder> cache_;  // shared by the copies odeint makes of the stepper
+  // The integrator, shared by the copies odeint makes of the stepper (they pass it by value): the slot
+  // exists from construction, so that the integrator a copy builds is the original's too.
+  std::shared_ptr<std::shared_ptr<Holder>> cache_ = std::make_shared<std::shared_ptr<Holder>>();
 };
 
 }  // namespace nystrom
