@@ -526,7 +526,9 @@ namespace {
 void add_strict_validators(CLI::App& app) {
   for (CLI::Option* opt : app.get_options()) {
     if (opt->get_expected_min() == 0) continue;  // flags
-    const std::string type = opt->get_type_name();
+    // "FLOAT", or "FLOAT:POSITIVE" etc. once a validator with a description is attached
+    const std::string full_type = opt->get_type_name();
+    const std::string type = full_type.substr(0, full_type.find(':'));
     if (type == "FLOAT" || type == "INT" || type == "UINT") {
       const bool integer = type != "FLOAT";
       const bool unsigned_ = type == "UINT";
