@@ -28,7 +28,7 @@ for h in $harnesses; do
   log="$build/fuzz_$h.log"
   echo "== fuzz_$h for ${seconds} s"
   # -timeout: one input running longer than 10 s is a finding (a hang); -rss_limit_mb: so is 2 GB of memory.
-  if "$build/fuzz_$h" "$corpus" "fuzz/corpus/$h" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  if "$build/fuzz/fuzz_$h" "$corpus" "fuzz/corpus/$h" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -max_len=4096 -print_final_stats=1 -artifact_prefix="$build/findings/$h/" >"$log" 2>&1; then
     # libFuzzer's last status line: "#N DONE cov: C ft: F corp: ... exec/s: E"
     grep -E '^#[0-9]+.*(DONE|pulse)' "$log" | tail -1 | sed 's/^/   /'

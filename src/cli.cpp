@@ -526,7 +526,9 @@ namespace {
 void add_strict_validators(CLI::App& app) {
   for (CLI::Option* opt : app.get_options()) {
     if (opt->get_expected_min() == 0) continue;  // flags
-    const std::string type = opt->get_type_name();
+    // "FLOAT", or "FLOAT:POSITIVE" etc. once a validator with a description is attached
+    const std::string full_type = opt->get_type_name();
+    const std::string type = full_type.substr(0, full_type.find(':'));
     if (type == "FLOAT" || type == "INT" || type == "UINT") {
       const bool integer = type != "FLOAT";
       const bool unsigned_ = type == "UINT";
@@ -590,6 +592,12 @@ Invocation parse_command_line(int argc, const char* const* argv, std::ostream& h
   } catch (const CLI::ParseError& e) {
     throw UsageError(std::string(e.what()) + " (see nystrom --help)");
   }
+  // CLI11 runs no validator on an empty argument and converts it to 0: refuse it here.
+  for (auto& [sub, action] : p.actions)
+    if (sub->parsed())
+      for (const CLI::Option* opt : sub->get_options())
+        for (const std::string& r : opt->results())
+          if (r.empty() && opt->get_expected_min() > 0) throw UsageError(opt->get_name() + ": must not be empty");
   for (auto& [sub, action] : p.actions)
     if (sub->parsed()) return {action, -1};
   throw UsageError("no subcommand given (see nystrom --help)");

@@ -236,7 +236,7 @@ TEST(CliHostile, MalformedInvocationsAreRefusedWithOneLine) {
       // method specifications: nesting, overflow, huge sequences, bytes
       {"coeffs", repeat("adjoint:", 5000) + "bogus"},
       {"coeffs", repeat("adjoint:", 5000) + "M4"},
-      {"run", "--method", repeat("adjoint:", 15000) + "bogus"},
+      {"run", "--method", repeat("adjoint:", 12000) + "bogus"},
       {"bch", "--method", repeat("adjoint:", 5000) + "M8"},
       {"coeffs", "m99999999999999999999"},
       {"coeffs", "m99999999999999999999-adaptive"},
