@@ -94,7 +94,7 @@ TEST(QuantumRealTime, ObservedOrderOfEveryApplicableMethod) {
   for (int n = 1; n <= 6; ++n) {
     std::string log;
     // high orders reach the rounding floor within a step or two at t = 1.3: integrate longer
-    std::string name = "M";  // appended, not "M" + ...: GCC 12 reports a false -Warray-bounds there (PR 105651)
+    std::string name = "M";  // appended: GCC 12 reports a false -Warray-bounds in libstdc++ for "M" + std::string
     name += std::to_string(2 * n);
     const double p = real_time_order(name, n <= 3 ? 1.3 : 4.3, log);
     // M10 and M12 on the oscillator converge faster than their order before the rounding floor is reached
