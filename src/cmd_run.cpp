@@ -36,7 +36,7 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--ecc", o->req.ecc, "Kepler eccentricity, 0 <= e < 1")
       ->capture_default_str()
       ->check(nystrom::cli::eccentricity_check());
-  app.add_option("--method", o->method, "Method name or spec (see `nystrom methods`)")->required();
+  app.add_option("--method", o->method, "Method name or spec (see `nystrom methods`; with --restart, the checkpoint's)");
   app.add_option("--steps-per-period", o->req.steps_per_period, "Steps per orbital period")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -53,6 +53,10 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--restart", o->sreq.restart, "Kepler: continue from a checkpoint file (the other options must match)");
   app.add_flag("--json", o->json, "Print one JSON object");
   return [o]() {
+    if (o->method.empty()) {
+      if (o->sreq.restart.empty()) throw nystrom::cli::UsageError("--method is required");
+      o->method = nystrom::cli::checkpoint_method(o->sreq.restart);
+    }
     const auto def = nystrom::cli::resolve_run_method(o->method);
     nystrom::cli::check_work_budget(nystrom::cli::run_work_units(o->req, def), "run");
     if (o->sreq.any()) {

@@ -188,4 +188,12 @@ SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq,
   return result;
 }
 
+std::string checkpoint_method(const std::string& path) {
+  try {
+    return read_checkpoint<double>(path).method;
+  } catch (const invalid_input& e) {
+    throw UsageError(e.what());
+  }
+}
+
 }  // namespace nystrom::cli

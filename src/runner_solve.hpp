@@ -32,4 +32,7 @@ struct SolveRunResult {
 /// Kepler in double precision through solve(); throws UsageError for bad input.
 SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq, const MethodDef& def);
 
+/// The method specification a checkpoint file was taken with; throws UsageError for an unreadable file.
+std::string checkpoint_method(const std::string& path);
+
 }  // namespace nystrom::cli
