@@ -169,17 +169,17 @@ P hand_m8(P s, double h, long n) {
 using HandLoop = P (*)(P, double, long);
 
 struct Case {
-  const char* name;     // the benchmark label
-  const char* method;   // the catalog method of the library variant
-  HandLoop hand;        // the hand-written loop
+  const char* name;    // the benchmark label
+  const char* method;  // the catalog method of the library variant
+  HandLoop hand;       // the hand-written loop
 };
 
 const std::vector<Case>& cases() {
   static const std::vector<Case> c{{"VV", "VV", hand_vv},
                                    {"FR", "FR", hand_fr},
-                                   {"M4", "M4", hand_m4},                // MPE engine vs eqs (33)-(34)
-                                   {"M4-sum", "M4", hand_m4_products},   // MPE engine vs sum of products
-                                   {"M4-RKN", "M4-RKN", hand_m4},        // RKN engine vs eqs (33)-(34)
+                                   {"M4", "M4", hand_m4},               // MPE engine vs eqs (33)-(34)
+                                   {"M4-sum", "M4", hand_m4_products},  // MPE engine vs sum of products
+                                   {"M4-RKN", "M4-RKN", hand_m4},       // RKN engine vs eqs (33)-(34)
                                    {"M8", "M8", hand_m8}};
   return c;
 }
@@ -192,7 +192,9 @@ P to_p(const State<V>& s) { return {s.q[0], s.q[1], s.v[0], s.v[1]}; }
 // default in double) costs extra additions that the plain hand-written loops do not do: the library is
 // measured with its default options and, where the option exists, with compensation off ("plain").
 template <class O>
-constexpr bool has_compensation_option = requires(O o) { decltype(o.compensated)::off; };
+constexpr bool has_compensation_option = requires(O o) {
+  decltype(o.compensated)::off;
+};
 
 template <class O>
 O plain_options(O o) {
@@ -238,8 +240,8 @@ bool check_hand_loops() {
     State<V> s = start();
     integ.integrate(s, step_size(), kSteps);
     const P lib = to_p(s), hand = c.hand(to_p(start()), step_size(), kSteps);
-    const double diff = std::max({std::abs(lib.x - hand.x), std::abs(lib.y - hand.y), std::abs(lib.vx - hand.vx),
-                                  std::abs(lib.vy - hand.vy)});
+    const double diff = std::max(
+        {std::abs(lib.x - hand.x), std::abs(lib.y - hand.y), std::abs(lib.vx - hand.vx), std::abs(lib.vy - hand.vy)});
     std::printf("check %-7s library vs hand-written after one period: max |difference| = %.2e\n", c.name, diff);
     if (!(diff < 1e-8)) {
       std::fprintf(stderr, "error: the hand-written %s loop does not reproduce the library's %s\n", c.name, c.method);
@@ -277,27 +279,28 @@ class SummaryReporter : public bench::MinTimeReporter {
     // 10 steps of the hand-written velocity Verlet loop (one force per step, each depending on the last).
     const double *vv = best("hand/VV"), *m8 = best("library-plain/M8"), *m8s = best("library-plain-sequential/M8");
     if (vv && m8) {
-      std::printf("M8 step (lockstep products, plain) / 10 sequential forces (10 hand VV steps): %.3f (target <= 0.5)\n",
-                  *m8 / (10 * *vv));
+      std::printf(
+          "M8 step (lockstep products, plain) / 10 sequential forces (10 hand VV steps): %.3f (target <= 0.5)\n",
+          *m8 / (10 * *vv));
       if (m8s) std::printf("M8 step (sequential products, plain) / 10 sequential forces: %.3f\n", *m8s / (10 * *vv));
     }
   }
-
 };
 
 }  // namespace
 
 int main(int argc, char** argv) {
   for (const auto& c : cases()) {
-    benchmark::RegisterBenchmark((std::string("hand/") + c.name).c_str(), [&c](benchmark::State& s) { bm_hand(s, c); })
-        ->MinTime(0.2);
-    benchmark::RegisterBenchmark((std::string("library/") + c.name).c_str(),
-                                 [&c](benchmark::State& s) { bm_library(s, c, false); })
-        ->MinTime(0.2);
+    benchmark::RegisterBenchmark((std::string("hand/") + c.name).c_str(), [&c](benchmark::State& s) {
+      bm_hand(s, c);
+    })->MinTime(0.2);
+    benchmark::RegisterBenchmark((std::string("library/") + c.name).c_str(), [&c](benchmark::State& s) {
+      bm_library(s, c, false);
+    })->MinTime(0.2);
     if (has_compensation_option<EngineOptions>)
-      benchmark::RegisterBenchmark((std::string("library-plain/") + c.name).c_str(),
-                                   [&c](benchmark::State& s) { bm_library(s, c, true); })
-          ->MinTime(0.2);
+      benchmark::RegisterBenchmark((std::string("library-plain/") + c.name).c_str(), [&c](benchmark::State& s) {
+        bm_library(s, c, true);
+      })->MinTime(0.2);
     if (is_mpe(c) && has_compensation_option<EngineOptions>)
       benchmark::RegisterBenchmark((std::string("library-plain-sequential/") + c.name).c_str(),
                                    [&c](benchmark::State& s) { bm_library(s, c, true, true); })

@@ -84,7 +84,6 @@ void bm_step(benchmark::State& state, Mode mode) {
   }
 }
 
-
 bool check_identical() {
   std::vector<State<std::vector<double>>> out;
   for (Mode m : {Mode::seq1, Mode::seqP, Mode::concP}) {

@@ -118,23 +118,14 @@ void sizes(benchmark::internal::Benchmark* b, bool with_threads) {
 }
 
 // One evaluation at N = 100 000 takes seconds: a single iteration there, a few at smaller N.
-void config(benchmark::internal::Benchmark* b) {
-  b->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
-}
+void config(benchmark::internal::Benchmark* b) { b->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime(); }
 
 }  // namespace
 
 BENCHMARK(BM_scalar_baseline)->Apply(config)->Arg(400)->Arg(10000);
 BENCHMARK(BM_scalar_baseline)->Apply(config)->Arg(100000)->Iterations(1);
-BENCHMARK(BM_force<NBodyKernel::simd, false>)
-    ->Name("simd_real")
-    ->Apply(config)
-    ->Apply([](auto* b) { sizes(b, true); });
-BENCHMARK(BM_force<NBodyKernel::generic, false>)
-    ->Name("generic_real")
-    ->Apply(config)
-    ->Args({400, 1})
-    ->Args({10000, 1});
+BENCHMARK(BM_force<NBodyKernel::simd, false>)->Name("simd_real")->Apply(config)->Apply([](auto* b) { sizes(b, true); });
+BENCHMARK(BM_force<NBodyKernel::generic, false>)->Name("generic_real")->Apply(config)->Args({400, 1})->Args({10000, 1});
 // The generic kernel on complex positions (std::complex<double>, the portable path) at the small N only.
 BENCHMARK(BM_force<NBodyKernel::generic, true>)->Name("generic_complex")->Apply(config)->Args({400, 1});
 BENCHMARK(BM_force<NBodyKernel::simd, true>)

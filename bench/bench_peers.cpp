@@ -33,10 +33,10 @@ void per_step(benchmark::State& st, np::MethodSpec m) {
     steps += n;
     forces += counter.calls;
   }
-  st.counters["ns/step"] = benchmark::Counter(static_cast<double>(steps) * 1e-9,
-                                               benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  st.counters["ns/force"] = benchmark::Counter(static_cast<double>(forces) * 1e-9,
-                                                benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["ns/step"] =
+      benchmark::Counter(static_cast<double>(steps) * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["ns/force"] =
+      benchmark::Counter(static_cast<double>(forces) * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 const int registered = [] {

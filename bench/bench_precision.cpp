@@ -49,8 +49,8 @@ constexpr long kSteps = 2000;  // per batch: one period at h = 2 pi / 2000
 const char* const kMethod = "M8";
 
 const std::vector<std::string>& precisions() {
-  static const std::vector<std::string> p{"double", "double+comp", "long-double", "float128", "dd", "qd", "mpfr:113",
-                                          "mpfr:256"};
+  static const std::vector<std::string> p{"double", "double+comp", "long-double", "float128",
+                                          "dd",     "qd",          "mpfr:113",    "mpfr:256"};
   return p;
 }
 
@@ -105,8 +105,8 @@ class SummaryReporter : public bench::MinTimeReporter {
  public:
   SummaryReporter() : MinTimeReporter(Clock::cpu, static_cast<double>(kSteps), 1e9) {}
   void summary() const {
-    std::printf("\n%s on Kepler e = %.1f, %ld steps per batch; minimum over repetitions of CPU time per step\n", kMethod,
-                kEcc, kSteps);
+    std::printf("\n%s on Kepler e = %.1f, %ld steps per batch; minimum over repetitions of CPU time per step\n",
+                kMethod, kEcc, kSteps);
 #ifdef __FMA__
     std::printf("built with hardware FMA: double-double products by fma\n");
 #else
@@ -121,11 +121,11 @@ class SummaryReporter : public bench::MinTimeReporter {
         std::printf("%-12s %12.1f %10s\n", p.c_str(), *t, "-");
       } else {
         const double ratio = *t / *base;
-        std::printf("%-12s %12.1f %10.2f%s\n", p.c_str(), *t, ratio, p == "dd" && ratio > 10 ? "  (target for dd: <= 10)" : "");
+        std::printf("%-12s %12.1f %10.2f%s\n", p.c_str(), *t, ratio,
+                    p == "dd" && ratio > 10 ? "  (target for dd: <= 10)" : "");
       }
     }
   }
-
 };
 
 }  // namespace

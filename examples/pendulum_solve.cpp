@@ -22,7 +22,8 @@ int main() {
   const auto sol = nystrom::solve(problem, "M12-adaptive", {.rtol = 1e-12, .t_eval = times}, events);
 
   std::printf("%8s %14s %14s\n", "t", "theta", "theta'");
-  for (std::size_t i = 0; i < sol.t.size(); ++i) std::printf("%8.3f %14.10f %14.10f\n", sol.t[i], sol.q[i][0], sol.v[i][0]);
+  for (std::size_t i = 0; i < sol.t.size(); ++i)
+    std::printf("%8.3f %14.10f %14.10f\n", sol.t[i], sol.q[i][0], sol.v[i][0]);
   for (const auto& e : sol.events) std::printf("bottom, moving right, at t = %.12f\n", e.t);
   std::printf("%ld steps (%ld rejected), %ld force evaluations; sol(12.3) = %.10f\n", sol.accepted, sol.rejected,
               sol.force_evals, sol(12.3).q[0]);

@@ -192,7 +192,8 @@ void write_file_atomic(const std::string& path, const std::string& content) {
     throw;
   }
   if (::close(fd) != 0) throw UsageError("cannot write '" + path + "': " + errno_text(errno));
-  if (::rename(tmpl.c_str(), target.c_str()) != 0) throw UsageError("cannot write '" + path + "': " + errno_text(errno));
+  if (::rename(tmpl.c_str(), target.c_str()) != 0)
+    throw UsageError("cannot write '" + path + "': " + errno_text(errno));
   tmp.release();
 }
 
@@ -228,7 +229,8 @@ double parse_double(const std::string& text, const std::string& what, bool posit
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
   if (end != text.c_str() + text.size()) throw UsageError(what + " must be a number, got '" + text + "'");
-  if (!std::isfinite(v) || (errno == ERANGE && std::abs(v) > 1)) throw UsageError(what + " must be finite, got '" + text + "'");
+  if (!std::isfinite(v) || (errno == ERANGE && std::abs(v) > 1))
+    throw UsageError(what + " must be finite, got '" + text + "'");
   if (errno == ERANGE) throw UsageError(what + " is too small to represent, got '" + text + "'");
   if (positive && !(v > 0)) throw UsageError(what + " must be positive, got '" + text + "'");
   return v;
@@ -240,7 +242,8 @@ long long parse_integer(const std::string& text, const std::string& what, long l
   const char* b = text.c_str() + (text[0] == '+' ? 1 : 0);
   const auto [ptr, ec] = std::from_chars(b, text.c_str() + text.size(), v);
   if (ec != std::errc() || ptr != text.c_str() + text.size() || v < lo || v > hi)
-    throw UsageError(what + " must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got '" + text + "'");
+    throw UsageError(what + " must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got '" + text +
+                     "'");
   return v;
 }
 
@@ -289,10 +292,11 @@ void check_work_budget(double units, const std::string& what) {
     if (end != env && *end == '\0' && v > 0 && std::isfinite(v)) limit = v;
   }
   if (!(units <= limit))  // also NaN
-    throw UsageError(fmt::format("{}: the estimated work is {:.3g} force evaluations (in units of one double-precision "
-                                 "Kepler force; an N-body force of n bodies counts n(n-1)/2), above the limit {:.3g} "
-                                 "(about {:.3g} hours at 3 ns per unit; NYSTROM_WORK_LIMIT raises it)",
-                                 what, units, limit, units * 3e-9 / 3600));
+    throw UsageError(
+        fmt::format("{}: the estimated work is {:.3g} force evaluations (in units of one double-precision "
+                    "Kepler force; an N-body force of n bodies counts n(n-1)/2), above the limit {:.3g} "
+                    "(about {:.3g} hours at 3 ns per unit; NYSTROM_WORK_LIMIT raises it)",
+                    what, units, limit, units * 3e-9 / 3600));
 }
 
 std::string printable(std::string_view text, std::size_t max) {
@@ -302,11 +306,16 @@ std::string printable(std::string_view text, std::size_t max) {
       out += "...";
       break;
     }
-    if (c == '\n') out += "\\n";
-    else if (c == '\t') out += "\\t";
-    else if (c == '\\') out += "\\\\";
-    else if (c < 0x20 || c >= 0x7f) out += fmt::format("\\x{:02x}", c);
-    else out += static_cast<char>(c);
+    if (c == '\n')
+      out += "\\n";
+    else if (c == '\t')
+      out += "\\t";
+    else if (c == '\\')
+      out += "\\\\";
+    else if (c < 0x20 || c >= 0x7f)
+      out += fmt::format("\\x{:02x}", c);
+    else
+      out += static_cast<char>(c);
   }
   return out;
 }
@@ -457,8 +466,7 @@ void plot_xy(const std::string& png_path, const std::string& title, const std::s
   script << "set terminal pngcairo size 900,650 enhanced font 'Sans,11'\n"
          << "set output 'plot.png'\n"
          << (axes.logx ? "set logscale x\nset format x '10^{%L}'\n" : "")
-         << (axes.logy ? "set logscale y\nset format y '10^{%L}'\n" : "")
-         << "set grid\nset key outside right top\n"
+         << (axes.logy ? "set logscale y\nset format y '10^{%L}'\n" : "") << "set grid\nset key outside right top\n"
          << "set title " << gnuplot_literal(title) << "\n"
          << "set xlabel " << gnuplot_literal(xlabel) << "\n"
          << "set ylabel " << gnuplot_literal(ylabel) << "\n";
@@ -477,11 +485,16 @@ void plot_xy(const std::string& png_path, const std::string& title, const std::s
     script << "$d" << idx << " << EOD\n" << block.str() << "EOD\n";
     const std::string pt = std::to_string(s.point_type > 0 && s.point_type < 100 ? s.point_type : 1 + idx % 12);
     std::string with;
-    if (s.style.empty() || s.style == "linespoints") with = "linespoints lw 2 pt " + pt;
-    else if (s.style == "lines") with = "lines lw 2";
-    else if (s.style == "points") with = "points ps 1.3 pt " + pt;
-    else if (s.style == "thick") with = "lines lw 6 lc rgb '#80808080'";
-    else throw std::invalid_argument("unknown plot style '" + s.style + "'");
+    if (s.style.empty() || s.style == "linespoints")
+      with = "linespoints lw 2 pt " + pt;
+    else if (s.style == "lines")
+      with = "lines lw 2";
+    else if (s.style == "points")
+      with = "points ps 1.3 pt " + pt;
+    else if (s.style == "thick")
+      with = "lines lw 6 lc rgb '#80808080'";
+    else
+      throw std::invalid_argument("unknown plot style '" + s.style + "'");
     // noenhanced: names such as velocity_verlet are drawn as written, without subscripts
     plots.push_back("$d" + std::to_string(idx) + " using 1:2 with " + with + " title " + gnuplot_literal(s.label) +
                     " noenhanced");
@@ -551,8 +564,8 @@ void add_strict_validators(CLI::App& app) {
           },
           "", "strict number"));
     } else if (type == "TEXT") {
-      opt->check(CLI::Validator([](std::string& v) -> std::string { return v.empty() ? "must not be empty" : ""; },
-                                "", "non-empty"));
+      opt->check(CLI::Validator([](std::string& v) -> std::string { return v.empty() ? "must not be empty" : ""; }, "",
+                                "non-empty"));
     }
   }
 }

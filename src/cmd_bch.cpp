@@ -48,8 +48,8 @@ std::string show_term(const an::ErrorTerm& t, double tol) {
 }
 
 nlohmann::json term_json(const an::ErrorTerm& t) {
-  nlohmann::json j{{"name", t.name},          {"definition", t.definition}, {"bracket", t.bracket},
-                   {"re", t.value.real()},    {"im", t.value.imag()},       {"abs", std::abs(t.value)}};
+  nlohmann::json j{{"name", t.name},       {"definition", t.definition}, {"bracket", t.bracket},
+                   {"re", t.value.real()}, {"im", t.value.imag()},       {"abs", std::abs(t.value)}};
   if (!t.exact.empty()) j["exact"] = t.exact;
   return j;
 }
@@ -68,8 +68,9 @@ int print_table() {
     }
     fmt::print(" {:>10.3e}\n", r.norm);
   }
-  fmt::print("(the paper prints the AC2 row with the opposite signs: it matches the adjoint of AC2, which for this\n"
-             " skew-symmetric method is its complex conjugate; AC1 and AC2 agree to 2-3 digits in every coefficient)\n");
+  fmt::print(
+      "(the paper prints the AC2 row with the opposite signs: it matches the adjoint of AC2, which for this\n"
+      " skew-symmetric method is its complex conjugate; AC1 and AC2 agree to 2-3 digits in every coefficient)\n");
   return 0;
 }
 
@@ -94,8 +95,7 @@ int run(const Options& o) {
       an::check_bch_work(sp->steps.size(), o.degree, "bch --method " + o.method);
   }
   const an::MethodAnalysis a = an::analyze_method(def, opt);
-  const std::string order_text =
-      a.order_is_lower_bound ? ">= " + std::to_string(a.order) : std::to_string(a.order);
+  const std::string order_text = a.order_is_lower_bound ? ">= " + std::to_string(a.order) : std::to_string(a.order);
   if (o.json) {
     nlohmann::json j;
     j["method"] = a.method;
@@ -130,8 +130,10 @@ int run(const Options& o) {
              def.info.source, a.basis == an::BasisKind::hall ? "Hall (Gurkan X_i)" : "Lyndon",
              a.algebra == an::AlgebraKind::rkn ? "RKN" : "free",
              a.algebra == an::AlgebraKind::rkn ? " ([V,[V,[T,V]]] = 0)" : "", a.degree);
-  fmt::print("arithmetic: {}; coefficients of H - Z, Z = log of the operator product (first sub-step rightmost)\n",
-             a.exact ? "exact rationals" : fmt::format("MPFR complex, {} bits; terms below {:.1e} count as zero", a.precision_bits, a.tolerance));
+  fmt::print(
+      "arithmetic: {}; coefficients of H - Z, Z = log of the operator product (first sub-step rightmost)\n",
+      a.exact ? "exact rationals"
+              : fmt::format("MPFR complex, {} bits; terms below {:.1e} count as zero", a.precision_bits, a.tolerance));
   for (const auto& d : a.degrees) {
     fmt::print("degree {} ({} term{}): {}\n", d.degree, d.terms.size(), d.terms.size() == 1 ? "" : "s",
                d.vanishes ? "vanishes" : fmt::format("norm {:.6e}", d.norm));
@@ -153,21 +155,20 @@ int run(const Options& o) {
   return 0;
 }
 
-nystrom::cli::Registrar reg("bch", "BCH error terms of a splitting method in a Lie basis (Gurkan Table 4.3)",
-                            [](CLI::App& app) {
-                              auto o = std::make_shared<Options>();
-                              app.add_option("--method", o->method, "Splitting method (catalog name, adjoint:NAME, file:PATH)");
-                              app.add_option("--degree", o->degree, "Highest degree of the series (1..12)")->capture_default_str();
-                              app.add_option("--basis", o->basis, "Lie basis: hall (Gurkan's X1..X23, extended) or lyndon")
-                                  ->capture_default_str();
-                              app.add_option("--algebra", o->algebra, "rkn ([V,[V,[T,V]]] = 0, for q'' = a(q)) or free")
-                                  ->capture_default_str();
-                              app.add_option("--bits", o->bits, "MPFR precision for irrational coefficients")->capture_default_str();
-                              app.add_option("--tolerance", o->tolerance, "Terms below this count as zero (0: from the published digits)");
-                              app.add_flag("--all", o->all, "Also list the terms of the vanishing degrees");
-                              app.add_flag("--json", o->json, "JSON output");
-                              app.add_flag("--gurkan-table", o->table, "Print Table 4.3 of the Gurkan paper computed from the catalog");
-                              return [o] { return run(*o); };
-                            });
+nystrom::cli::Registrar reg(
+    "bch", "BCH error terms of a splitting method in a Lie basis (Gurkan Table 4.3)", [](CLI::App& app) {
+      auto o = std::make_shared<Options>();
+      app.add_option("--method", o->method, "Splitting method (catalog name, adjoint:NAME, file:PATH)");
+      app.add_option("--degree", o->degree, "Highest degree of the series (1..12)")->capture_default_str();
+      app.add_option("--basis", o->basis, "Lie basis: hall (Gurkan's X1..X23, extended) or lyndon")
+          ->capture_default_str();
+      app.add_option("--algebra", o->algebra, "rkn ([V,[V,[T,V]]] = 0, for q'' = a(q)) or free")->capture_default_str();
+      app.add_option("--bits", o->bits, "MPFR precision for irrational coefficients")->capture_default_str();
+      app.add_option("--tolerance", o->tolerance, "Terms below this count as zero (0: from the published digits)");
+      app.add_flag("--all", o->all, "Also list the terms of the vanishing degrees");
+      app.add_flag("--json", o->json, "JSON output");
+      app.add_flag("--gurkan-table", o->table, "Print Table 4.3 of the Gurkan paper computed from the catalog");
+      return [o] { return run(*o); };
+    });
 
 }  // namespace

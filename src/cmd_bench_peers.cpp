@@ -55,8 +55,8 @@ nlohmann::json run_json(const np::PeerRun& r) {
           {"ok", r.ok}};
 }
 
-void plot(const std::string& dir, double ecc, const std::vector<np::PeerRun>& runs, const std::vector<std::string>& labels,
-          long periods) {
+void plot(const std::string& dir, double ecc, const std::vector<np::PeerRun>& runs,
+          const std::vector<std::string>& labels, long periods) {
   namespace cli = nystrom::cli;
   std::vector<cli::Series> by_forces, by_time;
   for (const auto& label : labels) {
@@ -75,8 +75,8 @@ void plot(const std::string& dir, double ecc, const std::vector<np::PeerRun>& ru
     }
   }
   const std::string title = fmt::format("Kepler e = {}, {} periods: nystrom vs Boost.Odeint", ecc_tag(ecc), periods);
-  cli::plot_loglog(dir + "/peers_forces_e" + ecc_tag(ecc) + ".png", title, "force evaluations",
-                   "final position error", by_forces);
+  cli::plot_loglog(dir + "/peers_forces_e" + ecc_tag(ecc) + ".png", title, "force evaluations", "final position error",
+                   by_forces);
   cli::plot_loglog(dir + "/peers_time_e" + ecc_tag(ecc) + ".png", title, "wall time (s)", "final position error",
                    by_time);
 }
@@ -160,14 +160,15 @@ nystrom::cli::Registrar reg(
             fmt::print("{:<26} {:>7} {:>5} {:>5} {:>11.3g} {:>11} {:>10}\n", label, any->library, any->order, n, emin,
                        std::isfinite(p) ? fmt::format("{:.2f}", p) : "-",
                        any->adaptive ? "-" : std::to_string(any->forces_per_step));
-            j["methods"].push_back({{"ecc", e},
-                                    {"label", label},
-                                    {"library", any->library},
-                                    {"adaptive", any->adaptive},
-                                    {"order", any->order},
-                                    {"runs", n},
-                                    {"min_error", std::isfinite(emin) ? nlohmann::json(emin) : nlohmann::json(nullptr)},
-                                    {"observed_order", std::isfinite(p) ? nlohmann::json(p) : nlohmann::json(nullptr)}});
+            j["methods"].push_back(
+                {{"ecc", e},
+                 {"label", label},
+                 {"library", any->library},
+                 {"adaptive", any->adaptive},
+                 {"order", any->order},
+                 {"runs", n},
+                 {"min_error", std::isfinite(emin) ? nlohmann::json(emin) : nlohmann::json(nullptr)},
+                 {"observed_order", std::isfinite(p) ? nlohmann::json(p) : nlohmann::json(nullptr)}});
           }
         }
 
@@ -175,8 +176,8 @@ nystrom::cli::Registrar reg(
         // uncompensated variants too, which odeint's configurations all are).
         for (const bool any_config : {false, true}) {
           fmt::print("\n## fastest run reaching each target error (wall time){}\n{:>5} {:>7}  {:<58} {:<58} {:>8}\n",
-                     any_config ? ", nystrom's uncompensated variants included" : "", "e", "target", "nystrom", "odeint",
-                     "ratio");
+                     any_config ? ", nystrom's uncompensated variants included" : "", "e", "target", "nystrom",
+                     "odeint", "ratio");
           const char* key = any_config ? "targets_any_configuration" : "targets";
           j[key] = nlohmann::json::array();
           for (double e : eccs)
@@ -185,10 +186,10 @@ nystrom::cli::Registrar reg(
               const np::PeerRun* b = np::cheapest(runs, "odeint", e, target);
               auto desc = [](const np::PeerRun* r) {
                 if (!r) return std::string("not reached");
-                return fmt::format("{} {} {:.3g}s {:.2g} {}f {:.1f}ns/f", r->label,
-                                   r->adaptive ? fmt::format("tol {:.0e}", r->param) : fmt::format("{:.0f}/T", r->param),
-                                   r->seconds, r->error, r->forces,
-                                   r->seconds * 1e9 / static_cast<double>(std::max(1L, r->forces)));
+                return fmt::format(
+                    "{} {} {:.3g}s {:.2g} {}f {:.1f}ns/f", r->label,
+                    r->adaptive ? fmt::format("tol {:.0e}", r->param) : fmt::format("{:.0f}/T", r->param), r->seconds,
+                    r->error, r->forces, r->seconds * 1e9 / static_cast<double>(std::max(1L, r->forces)));
               };
               const double ratio = a && b ? b->seconds / a->seconds : std::numeric_limits<double>::quiet_NaN();
               fmt::print("{:>5} {:>7.0e}  {:<58} {:<58} {:>8}\n", ecc_tag(e), target, desc(a), desc(b),
@@ -199,8 +200,12 @@ nystrom::cli::Registrar reg(
                                 {"nystrom", rj(a)},
                                 {"odeint", rj(b)},
                                 {"ratio", std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr)},
-                                {"nystrom_ns_per_force", a && a->forces > 0 ? nlohmann::json(a->seconds * 1e9 / static_cast<double>(a->forces)) : nlohmann::json(nullptr)},
-                                {"odeint_ns_per_force", b && b->forces > 0 ? nlohmann::json(b->seconds * 1e9 / static_cast<double>(b->forces)) : nlohmann::json(nullptr)}});
+                                {"nystrom_ns_per_force",
+                                 a && a->forces > 0 ? nlohmann::json(a->seconds * 1e9 / static_cast<double>(a->forces))
+                                                    : nlohmann::json(nullptr)},
+                                {"odeint_ns_per_force",
+                                 b && b->forces > 0 ? nlohmann::json(b->seconds * 1e9 / static_cast<double>(b->forces))
+                                                    : nlohmann::json(nullptr)}});
             }
         }
 
@@ -208,9 +213,10 @@ nystrom::cli::Registrar reg(
         // runs measured at the same moments, not minutes apart.
         {
           const int pairs = o->quick ? 2 : 25;
-          fmt::print("\n## the same runs re-timed alternately ({} times each, fastest of each)\n{:>5} {:>7}  {:<26} {:>11} "
-                     "{:<28} {:>11} {:>8}\n",
-                     pairs, "e", "target", "nystrom", "seconds", "odeint", "seconds", "ratio");
+          fmt::print(
+              "\n## the same runs re-timed alternately ({} times each, fastest of each)\n{:>5} {:>7}  {:<26} {:>11} "
+              "{:<28} {:>11} {:>8}\n",
+              pairs, "e", "target", "nystrom", "seconds", "odeint", "seconds", "ratio");
           auto spec = [&](const np::PeerRun& r) -> const np::MethodSpec* {
             for (const auto& [e, m] : jobs)
               if (e == r.ecc && m.label == r.label) return &m;
@@ -229,40 +235,46 @@ nystrom::cli::Registrar reg(
               const double ratio = ok ? ob.seconds / oa.seconds : std::numeric_limits<double>::quiet_NaN();
               fmt::print("{:>5} {:>7.0e}  {:<26} {:>11.3g} {:<28} {:>11.3g} {:>8}\n", ecc_tag(e), target, a->label,
                          oa.seconds, b->label, ob.seconds, ok ? fmt::format("{:.1f}x", ratio) : "failed");
-              j["targets_interleaved"].push_back({{"ecc", e},
-                                                  {"target", target},
-                                                  {"pairs", pairs},
-                                                  {"nystrom", a->label},
-                                                  {"nystrom_param", a->param},
-                                                  {"nystrom_seconds", oa.seconds},
-                                                  {"nystrom_error", ok ? nlohmann::json(oa.error) : nlohmann::json(nullptr)},
-                                                  {"odeint", b->label},
-                                                  {"odeint_param", b->param},
-                                                  {"odeint_seconds", ob.seconds},
-                                                  {"odeint_error", ok ? nlohmann::json(ob.error) : nlohmann::json(nullptr)},
-                                                  {"ratio", ok ? nlohmann::json(ratio) : nlohmann::json(nullptr)}});
+              j["targets_interleaved"].push_back(
+                  {{"ecc", e},
+                   {"target", target},
+                   {"pairs", pairs},
+                   {"nystrom", a->label},
+                   {"nystrom_param", a->param},
+                   {"nystrom_seconds", oa.seconds},
+                   {"nystrom_error", ok ? nlohmann::json(oa.error) : nlohmann::json(nullptr)},
+                   {"odeint", b->label},
+                   {"odeint_param", b->param},
+                   {"odeint_seconds", ob.seconds},
+                   {"odeint_error", ok ? nlohmann::json(ob.error) : nlohmann::json(nullptr)},
+                   {"ratio", ok ? nlohmann::json(ratio) : nlohmann::json(nullptr)}});
             }
         }
 
         // Round-off: compensated summation on and off.
-        fmt::print("\n## round-off floor: smallest error with compensated summation on / off\n{:>5} {:<13} {:>11} {:>11} {:>8}\n",
-                   "e", "method", "on", "off", "off/on");
+        fmt::print(
+            "\n## round-off floor: smallest error with compensated summation on / off\n{:>5} {:<13} {:>11} {:>11} "
+            "{:>8}\n",
+            "e", "method", "on", "off", "off/on");
         j["compensation"] = nlohmann::json::array();
         for (double e : eccs)
           for (const char* name : {"M8", "SS10", "DP12", "M12-adaptive"}) {
-            const double on = np::min_error(runs, name, e), off = np::min_error(runs, std::string(name) + " (no comp.)", e);
+            const double on = np::min_error(runs, name, e),
+                         off = np::min_error(runs, std::string(name) + " (no comp.)", e);
             fmt::print("{:>5} {:<13} {:>11.3g} {:>11.3g} {:>8.1f}\n", ecc_tag(e), name, on, off, off / on);
-            j["compensation"].push_back({{"ecc", e},
-                                         {"method", name},
-                                         {"min_error_on", std::isfinite(on) ? nlohmann::json(on) : nlohmann::json(nullptr)},
-                                         {"min_error_off", std::isfinite(off) ? nlohmann::json(off) : nlohmann::json(nullptr)}});
+            j["compensation"].push_back(
+                {{"ecc", e},
+                 {"method", name},
+                 {"min_error_on", std::isfinite(on) ? nlohmann::json(on) : nlohmann::json(nullptr)},
+                 {"min_error_off", std::isfinite(off) ? nlohmann::json(off) : nlohmann::json(nullptr)}});
           }
 
-        std::string csv = "library,method,adaptive,compensated,order,forces_per_step,ecc,param,steps,forces,seconds,error,reps,ok\n";
+        std::string csv =
+            "library,method,adaptive,compensated,order,forces_per_step,ecc,param,steps,forces,seconds,error,reps,ok\n";
         for (const auto& r : runs)
-          csv += fmt::format("{},{},{},{},{},{},{},{:.6g},{},{},{:.6g},{:.6g},{},{}\n", r.library, r.label, r.adaptive ? 1 : 0,
-                             r.compensated ? 1 : 0, r.order, r.forces_per_step, r.ecc, r.param, r.steps, r.forces,
-                             r.seconds, r.error, r.reps, r.ok ? 1 : 0);
+          csv += fmt::format("{},{},{},{},{},{},{},{:.6g},{},{},{:.6g},{:.6g},{},{}\n", r.library, r.label,
+                             r.adaptive ? 1 : 0, r.compensated ? 1 : 0, r.order, r.forces_per_step, r.ecc, r.param,
+                             r.steps, r.forces, r.seconds, r.error, r.reps, r.ok ? 1 : 0);
         write_file_atomic(o->out + "/peers_runs.csv", csv);
         write_file_atomic(o->out + "/peers.json", j.dump(1) + "\n");
         if (!o->no_plot) {

@@ -1,8 +1,8 @@
 // `nystrom coeffs mpe --seq 1,2,3 [--json]`: exact MPE coefficients (Chin eqs 14-15);
 // `nystrom coeffs NAME [--digits D] [--json]`: the coefficients of any catalog method.
+#include <iomanip>
 #include <iostream>
 #include <memory>
-#include <iomanip>
 #include <sstream>
 
 #include <fmt/core.h>
@@ -139,7 +139,8 @@ nystrom::cli::Registrar reg("coeffs", "Print coefficients: exact MPE rationals, 
                               app.add_option("--seq", o->seq, "MPE sequence, e.g. 1,2,3");
                               app.add_option("--order", o->order, "MPE natural sequence of this even order");
                               app.add_option("--n", o->n, "MPE: number of products (with --sum)");
-                              app.add_option("--sum", o->sum, "MPE: optimal sequence of --n members summing to this (eq 16)");
+                              app.add_option("--sum", o->sum,
+                                             "MPE: optimal sequence of --n members summing to this (eq 16)");
                               app.add_option("--digits", o->digits, "Digits printed for decimal coefficients");
                               app.add_flag("--json", o->json, "Print JSON");
                               return [o]() { return o->what == "mpe" ? mpe(*o) : method(*o); };

@@ -141,7 +141,8 @@ int run_search(const Options& o) {
           f = f == nystrom::Flow::drift ? nystrom::Flow::kick : nystrom::Flow::drift;
         }
         nlohmann::json lead = nlohmann::json::array();
-        for (const auto& t : m.leading) lead.push_back({{"name", t.name}, {"re", t.value.real()}, {"im", t.value.imag()}});
+        for (const auto& t : m.leading)
+          lead.push_back({{"name", t.name}, {"re", t.value.real()}, {"im", t.value.imag()}});
         methods.push_back({{"class", an::to_string(m.cls)},
                            {"positive", m.positive},
                            {"skew_symmetric", m.skew_symmetric},
@@ -173,18 +174,20 @@ int run_search(const Options& o) {
                      {"seconds", seconds},
                      {"methods", methods}});
     } else {
-      fmt::print("{} (Gurkan eq {}), {} random starts in [-{:g},{:g}]^2 per unknown, seed {}, {} ({} threads): {:.1f} s\n",
-                 an::to_string(form), form == an::RknForm::A ? "3.6" : "3.8", o.starts, o.box, o.box, o.seed, o.solver,
-                 opt.threads, seconds);
-      fmt::print("  {} starts converged; {} distinct methods up to adjoint and conjugation; {} converged points were "
-                 "singular (not polished)\n",
-                 rep.converged, rep.methods.size(), rep.not_polished);
+      fmt::print(
+          "{} (Gurkan eq {}), {} random starts in [-{:g},{:g}]^2 per unknown, seed {}, {} ({} threads): {:.1f} s\n",
+          an::to_string(form), form == an::RknForm::A ? "3.6" : "3.8", o.starts, o.box, o.box, o.seed, o.solver,
+          opt.threads, seconds);
+      fmt::print(
+          "  {} starts converged; {} distinct methods up to adjoint and conjugation; {} converged points were "
+          "singular (not polished)\n",
+          rep.converged, rep.methods.size(), rep.not_polished);
       fmt::print("  REAL {}   IMAGINARY {} ({} with positive real parts)   OTHER {} ({} with positive real parts)\n",
                  rep.count(an::MethodClass::real), rep.count(an::MethodClass::imaginary),
                  rep.count(an::MethodClass::imaginary, true), rep.count(an::MethodClass::other),
                  rep.count(an::MethodClass::other, true));
-      fmt::print("  {:>3} {:<5} {:>3} {:>4} {:>11} {:>8} {:>6} {:>6}  {}\n", "#", "class", "pos", "skew", "|err6|", "max|c|",
-                 "hits", "digits", "published");
+      fmt::print("  {:>3} {:<5} {:>3} {:>4} {:>11} {:>8} {:>6} {:>6}  {}\n", "#", "class", "pos", "skew", "|err6|",
+                 "max|c|", "hits", "digits", "published");
       int idx = 0;
       for (const auto& m : rep.methods) {
         ++idx;
@@ -216,11 +219,13 @@ int run_search(const Options& o) {
             "{} method from the order conditions (2.4); {} leading error, norm {:.4e}{}{}", an::to_string(form),
             an::to_string(m.cls), m.error_norm, m.positive ? ", positive real parts" : "",
             match.empty() ? "" : "; equals " + match + " (Gurkan Tables 4.1/4.2) up to adjoint/conjugation");
-        const std::string src = fmt::format("nystrom discover --scheme {} --starts {} --seed {} --solver {} (polished, {} digits)",
-                                            form == an::RknForm::A ? "A" : "B", o.starts, o.seed, o.solver, m.digits);
+        const std::string src =
+            fmt::format("nystrom discover --scheme {} --starts {} --seed {} --solver {} (polished, {} digits)",
+                        form == an::RknForm::A ? "A" : "B", o.starts, o.seed, o.solver, m.digits);
         const std::string path = (std::filesystem::path(o.write) / (name + ".txt")).string();
         nystrom::BigPrecision guard(o.polish_bits);
-        nystrom::cli::write_file_atomic(path, an::format_method_file(name, 5, src, desc, m.scheme(), std::min(o.digits * 2, 60)));
+        nystrom::cli::write_file_atomic(
+            path, an::format_method_file(name, 5, src, desc, m.scheme(), std::min(o.digits * 2, 60)));
         ++written;
       }
       if (!o.json) fmt::print("  wrote {} method files to {}\n", written, o.write);
@@ -262,7 +267,8 @@ int run_six(const Options& o) {
     nlohmann::json minima = nlohmann::json::array();
     for (const auto& m : res.minima) {
       nlohmann::json coefs = nlohmann::json::array();
-      for (const auto& c : m.coefficients) coefs.push_back({{"re", an::big_str(c.re, o.digits)}, {"im", an::big_str(c.im, o.digits)}});
+      for (const auto& c : m.coefficients)
+        coefs.push_back({{"re", an::big_str(c.re, o.digits)}, {"im", an::big_str(c.im, o.digits)}});
       minima.push_back({{"error_norm", m.error_norm},
                         {"constraint_residual", m.constraint_residual},
                         {"iterations", m.iterations},
@@ -281,13 +287,15 @@ int run_six(const Options& o) {
                      .dump(2)
               << "\n";
   } else {
-    fmt::print("eq (6.1): skew-symmetric six-stage methods (kick first, 7 kicks, 6 drifts) of order 5 from {} "
-               "(norm {:.4e}), {} tries (seed {}, tangent moves up to {:g}): {:.1f} s, {} did not converge\n",
-               o.from, res.minima.front().start_error_norm, o.tries, o.seed, o.perturbation, seconds, res.failed);
+    fmt::print(
+        "eq (6.1): skew-symmetric six-stage methods (kick first, 7 kicks, 6 drifts) of order 5 from {} "
+        "(norm {:.4e}), {} tries (seed {}, tangent moves up to {:g}): {:.1f} s, {} did not converge\n",
+        o.from, res.minima.front().start_error_norm, o.tries, o.seed, o.perturbation, seconds, res.failed);
     fmt::print("  local minima of (sum |X_i|^2)^(1/2) over the degree-6 terms:\n");
     for (const auto& m : res.minima)
-      fmt::print("    {:.6e}   (order conditions to {:.1e}; distance to the published eq 6.1 method {:.2e})\n", m.error_norm,
-                 m.constraint_residual, an::max_distance(an::scheme_coefficients(m.scheme()), paper_coefs));
+      fmt::print("    {:.6e}   (order conditions to {:.1e}; distance to the published eq 6.1 method {:.2e})\n",
+                 m.error_norm, m.constraint_residual,
+                 an::max_distance(an::scheme_coefficients(m.scheme()), paper_coefs));
     fmt::print("  published eq (6.1) method: norm {:.6e}\n", pa.degrees[5].norm);
     fmt::print("  best method (time order; first half, middle; the rest are complex conjugates in reverse order):\n");
     const auto& b = res.minima.front();
@@ -298,13 +306,14 @@ int run_six(const Options& o) {
     const auto& b = res.minima.front();
     const std::string name = std::filesystem::path(o.write).stem().string();
     nystrom::cli::write_file_atomic(
-        o.write, an::format_method_file(an::detail::valid_name(name) ? name : "six-stage", 5,
-                                        fmt::format("nystrom discover --six-stage --from {} --tries {} --seed {}", o.from,
-                                                    o.tries, o.seed),
-                                        fmt::format("skew-symmetric six-stage fifth-order RKN splitting (Gurkan eq 6.1), "
-                                                    "sixth-order error norm {:.4e}",
-                                                    b.error_norm),
-                                        b.scheme(), std::min(2 * o.digits, 45)));
+        o.write,
+        an::format_method_file(
+            an::detail::valid_name(name) ? name : "six-stage", 5,
+            fmt::format("nystrom discover --six-stage --from {} --tries {} --seed {}", o.from, o.tries, o.seed),
+            fmt::format("skew-symmetric six-stage fifth-order RKN splitting (Gurkan eq 6.1), "
+                        "sixth-order error norm {:.4e}",
+                        b.error_norm),
+            b.scheme(), std::min(2 * o.digits, 45)));
     if (!o.json) fmt::print("  wrote {}\n", o.write);
   }
   return 0;
@@ -314,9 +323,13 @@ nystrom::cli::Registrar reg(
     "discover", "Find fifth-order RKN splittings from the order conditions (Gurkan sec. 4, eq 6.1)", [](CLI::App& app) {
       auto o = std::make_shared<Options>();
       app.add_option("--scheme", o->scheme, "A (RKNA, eq 3.6), B (RKNB, eq 3.8) or both")->capture_default_str();
-      app.add_option("--starts", o->starts, "Random starts per scheme")->capture_default_str()->check(CLI::Range(1L, 1000000L));
+      app.add_option("--starts", o->starts, "Random starts per scheme")
+          ->capture_default_str()
+          ->check(CLI::Range(1L, 1000000L));
       app.add_option("--seed", o->seed, "Seed of the random starts")->capture_default_str();
-      app.add_option("--threads", o->threads, "Threads (0: all cores, at most 8)")->capture_default_str()->check(CLI::Range(0, 256));
+      app.add_option("--threads", o->threads, "Threads (0: all cores, at most 8)")
+          ->capture_default_str()
+          ->check(CLI::Range(0, 256));
       app.add_option("--solver", o->solver, "newton (damped) or lm (Levenberg-Marquardt)")->capture_default_str();
       app.add_option("--box", o->box, "Starts uniform in [-box, box] for real and imaginary parts")
           ->capture_default_str()
@@ -325,12 +338,14 @@ nystrom::cli::Registrar reg(
           ->capture_default_str()
           ->check(CLI::Range(64u, 4096u));
       app.add_option("--digits", o->digits, "Digits printed")->capture_default_str();
-      app.add_option("--show", o->show, "Methods listed: classified (REAL, IMAGINARY, positive), all, real, imaginary, positive")
+      app.add_option("--show", o->show,
+                     "Methods listed: classified (REAL, IMAGINARY, positive), all, real, imaginary, positive")
           ->capture_default_str();
       app.add_flag("--coefficients", o->coefficients, "Print the coefficients of the listed methods");
       app.add_flag("--json", o->json, "JSON output");
-      app.add_option("--write", o->write,
-                     "Write the listed methods as method files into this folder (search) or to this file (--six-stage)");
+      app.add_option(
+          "--write", o->write,
+          "Write the listed methods as method files into this folder (search) or to this file (--six-stage)");
       app.add_flag("--six-stage", o->six, "Eq (6.1): minimise the sixth-order error of a six-stage method near --from");
       app.add_option("--from", o->from, "Start of --six-stage (an RKNA method)")->capture_default_str();
       app.add_option("--tries", o->tries, "--six-stage: the start plus tries-1 random moves along the constraints")
@@ -343,7 +358,8 @@ nystrom::cli::Registrar reg(
           ->capture_default_str()
           ->check(CLI::Range(0u, 4096u));
       app.footer(
-          "Rediscovering Gurkan's Tables 4.1 and 4.2: `nystrom discover --seed 1` (2000 starts per scheme, the default)\n"
+          "Rediscovering Gurkan's Tables 4.1 and 4.2: `nystrom discover --seed 1` (2000 starts per scheme, the "
+          "default)\n"
           "finds all nine published methods (AR1 AR2 AC1 AC2 among the RKNA solutions, BR1 BR2 BR3 BC1 BC2 among the\n"
           "RKNB ones; the last of them first reached at start 219 of RKNA and 436 of RKNB) in about 40 s of processor\n"
           "time for both schemes; each run prints its wall time.\n"

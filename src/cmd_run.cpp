@@ -36,21 +36,26 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--ecc", o->req.ecc, "Kepler eccentricity, 0 <= e < 1")
       ->capture_default_str()
       ->check(nystrom::cli::eccentricity_check());
-  app.add_option("--method", o->method, "Method name or spec (see `nystrom methods`; with --restart, the checkpoint's)");
+  app.add_option("--method", o->method,
+                 "Method name or spec (see `nystrom methods`; with --restart, the checkpoint's)");
   app.add_option("--steps-per-period", o->req.steps_per_period, "Steps per orbital period")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  app.add_option("--periods", o->req.periods, "Number of whole periods")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--periods", o->req.periods, "Number of whole periods")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--precision", o->req.precision, "Scalar type (double, long-double, ...)")->capture_default_str();
   app.add_option("--tol", o->req.tol, "Tolerance of an adaptive method (e.g. DP12-adaptive)")
       ->check(nystrom::cli::tolerance_check());
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
   app.add_option("--output-times", o->sreq.output_times,
                  "Kepler: A:B:N, the state at N equally spaced times from A to B (dense output; JSON `output`)");
-  app.add_option("--events", o->sreq.events, "Kepler: events to locate, any of pericentre,apocentre,y=0 (JSON `events`)");
+  app.add_option("--events", o->sreq.events,
+                 "Kepler: events to locate, any of pericentre,apocentre,y=0 (JSON `events`)");
   app.add_option("--checkpoint", o->sreq.checkpoint, "Kepler: write the integrator's state to this file ...");
   app.add_option("--checkpoint-at", o->sreq.checkpoint_at, "... at the first step boundary at or after this time");
-  app.add_option("--restart", o->sreq.restart, "Kepler: continue from a checkpoint file (the other options must match)");
+  app.add_option("--restart", o->sreq.restart,
+                 "Kepler: continue from a checkpoint file (the other options must match)");
   app.add_flag("--json", o->json, "Print one JSON object");
   return [o]() {
     if (o->method.empty()) {

@@ -49,10 +49,11 @@ Claim Claim::from_json(const nlohmann::json& j) {
 nlohmann::json TargetResult::to_json() const {
   nlohmann::json cl = nlohmann::json::array();
   for (const auto& c : claims) cl.push_back(c.to_json());
-  return {{"name", name},         {"title", title},   {"paper", paper},
-          {"quick", quick},       {"seconds", seconds}, {"precision", precision},
-          {"files", files},       {"interpretation", interpretation},
-          {"table", table},       {"claims", cl}};
+  return {{"name", name},       {"title", title},
+          {"paper", paper},     {"quick", quick},
+          {"seconds", seconds}, {"precision", precision},
+          {"files", files},     {"interpretation", interpretation},
+          {"table", table},     {"claims", cl}};
 }
 
 TargetResult TargetResult::from_json(const nlohmann::json& j) {
@@ -128,9 +129,12 @@ Claim band_claim(std::string id, std::string paper, double published, double mea
   c.published = published;
   c.measured = measured;
   c.measured_text = fmt_g(measured);
-  if (std::isinf(hi) && !std::isinf(lo)) c.criterion = "measured >= " + fmt_g(lo);
-  else if (std::isinf(lo) && !std::isinf(hi)) c.criterion = "measured <= " + fmt_g(hi);
-  else c.criterion = fmt_g(lo) + " <= measured <= " + fmt_g(hi);
+  if (std::isinf(hi) && !std::isinf(lo))
+    c.criterion = "measured >= " + fmt_g(lo);
+  else if (std::isinf(lo) && !std::isinf(hi))
+    c.criterion = "measured <= " + fmt_g(hi);
+  else
+    c.criterion = fmt_g(lo) + " <= measured <= " + fmt_g(hi);
   c.holds = std::isfinite(measured) && measured >= lo && measured <= hi;
   c.qualitative = std::move(qualitative);
   c.qualitative_holds = qualitative_holds;

@@ -23,11 +23,11 @@ inline constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 /// One statement of a paper, checked against this run.
 struct Claim {
-  std::string id;         // short key, unique within the target, e.g. "kl8_over_m8"
-  std::string paper;      // what the paper says, with its numbers
-  std::string criterion;  // the numeric test applied to `measured` for `holds`
-  double published = nan; // the published number, where the paper gives one
-  double measured = nan;  // the number this run measured
+  std::string id;             // short key, unique within the target, e.g. "kl8_over_m8"
+  std::string paper;          // what the paper says, with its numbers
+  std::string criterion;      // the numeric test applied to `measured` for `holds`
+  double published = nan;     // the published number, where the paper gives one
+  double measured = nan;      // the number this run measured
   std::string measured_text;  // `measured` as shown in the report
   bool holds = false;         // the numeric statement holds as published (within the stated tolerance)
   std::string qualitative;    // the claim in words: the direction / ordering the paper asserts
@@ -39,13 +39,13 @@ struct Claim {
 };
 
 struct TargetResult {
-  std::string name, title, paper;   // paper: the figure or table and the publication
+  std::string name, title, paper;  // paper: the figure or table and the publication
   bool quick = false;
   double seconds = 0;
-  std::string precision;            // scalar type(s) used
-  std::vector<std::string> files;   // written next to the report, names relative to the output folder
+  std::string precision;                    // scalar type(s) used
+  std::vector<std::string> files;           // written next to the report, names relative to the output folder
   std::vector<std::string> interpretation;  // choices where the paper does not say (markdown bullets)
-  std::string table;                // a markdown table of the key numbers
+  std::string table;                        // a markdown table of the key numbers
   std::vector<Claim> claims;
 
   nlohmann::json to_json() const;
@@ -53,10 +53,10 @@ struct TargetResult {
 };
 
 struct Context {
-  std::string out_dir;       // CSV, PNG and JSON files
-  bool quick = false;        // the reduced version (CI)
-  std::string quad = "dd";   // the quadruple-precision type of the Chin Figs 2-3 (dd or float128)
-  int threads = 0;           // N-body force threads (0: OpenMP default)
+  std::string out_dir;      // CSV, PNG and JSON files
+  bool quick = false;       // the reduced version (CI)
+  std::string quad = "dd";  // the quadruple-precision type of the Chin Figs 2-3 (dd or float128)
+  int threads = 0;          // N-body force threads (0: OpenMP default)
   std::string path(const std::string& file) const { return out_dir + "/" + file; }
 };
 

@@ -9,15 +9,15 @@
 #include <cmath>
 #include <complex>
 #include <limits>
-#include <stdexcept>
 #include <map>
+#include <stdexcept>
 
 #include <fmt/core.h>
 
 #include "cli.hpp"
-#include "reproduce.hpp"
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "reproduce.hpp"
 
 namespace nystrom::cli::reproduce {
 
@@ -65,9 +65,7 @@ long digit_offset(double published, double computed, int digits) {
 double printed_part(cd published, cd v) { return published.imag() != 0 ? v.imag() : v.real(); }
 double other_part(cd published, cd v) { return published.imag() != 0 ? v.real() : v.imag(); }
 
-std::string show(cd p) {
-  return p.imag() != 0 ? fmt::format("{:.1e}i", p.imag()) : fmt::format("{:.1e}", p.real());
-}
+std::string show(cd p) { return p.imag() != 0 ? fmt::format("{:.1e}i", p.imag()) : fmt::format("{:.1e}", p.real()); }
 std::string show_full(cd v, bool imag) {
   return imag ? fmt::format("{:.4e}i", v.imag()) : fmt::format("{:.4e}", v.real());
 }
@@ -91,8 +89,9 @@ TargetResult gurkan_table43(const Context& ctx) {
   }
 
   std::string csv = "method,term,published_re,published_im,computed_re,computed_im,printed_digits,last_digit_offset\n";
-  std::string tb = "Each cell: published / computed (rounded to the printed digits); a mark after the computed value "
-                   "gives its offset in units of the last printed digit, or says that only the sign differs.\n\n| method |";
+  std::string tb =
+      "Each cell: published / computed (rounded to the printed digits); a mark after the computed value "
+      "gives its offset in units of the last printed digit, or says that only the sign differs.\n\n| method |";
   for (const char* t : kTerms) tb += fmt::format(" {} |", t);
   tb += " norm | digits agreeing |\n|---|---|---|---|---|---|---|---|\n";
   Series pub_vs{"X_i (published sign)", {}, {}, "points", 7}, neg_vs{"X_i (opposite sign)", {}, {}, "points", 6},
@@ -120,15 +119,18 @@ TargetResult gurkan_table43(const Context& ctx) {
       abs_agree += digit_offset(std::abs(pub), std::abs(got), 2) == 0;
       opposite += pub * got < 0;
       const double rel_other = std::abs(other_part(p.x[k], v)) / std::max(1e-300, std::abs(v));
-      if (cplx) worst_imag_real = std::max(worst_imag_real, rel_other);
-      else worst_real_imag = std::max(worst_real_imag, rel_other);
+      if (cplx)
+        worst_imag_real = std::max(worst_imag_real, rel_other);
+      else
+        worst_real_imag = std::max(worst_real_imag, rel_other);
       const double u = unit_of(pub, 2);
-      tb += fmt::format(" {} / {}{} |", show(p.x[k]), show(cplx ? cd(0, std::lround(got / u) * u) : cd(std::lround(got / u) * u, 0)),
-                        off == 0                                                      ? ""
-                        : pub * got < 0 && digit_offset(std::abs(pub), std::abs(got), 2) == 0 ? " (opposite sign)"
-                                                                                               : fmt::format(" ({:+d})", off));
-      csv += fmt::format("{},{},{:.2g},{:.2g},{:.17g},{:.17g},2,{}\n", p.method, kTerms[k], p.x[k].real(), p.x[k].imag(),
-                         v.real(), v.imag(), off);
+      tb += fmt::format(
+          " {} / {}{} |", show(p.x[k]), show(cplx ? cd(0, std::lround(got / u) * u) : cd(std::lround(got / u) * u, 0)),
+          off == 0                                                              ? ""
+          : pub * got < 0 && digit_offset(std::abs(pub), std::abs(got), 2) == 0 ? " (opposite sign)"
+                                                                                : fmt::format(" ({:+d})", off));
+      csv += fmt::format("{},{},{:.2g},{:.2g},{:.17g},{:.17g},2,{}\n", p.method, kTerms[k], p.x[k].real(),
+                         p.x[k].imag(), v.real(), v.imag(), off);
       (pub * got > 0 ? pub_vs : neg_vs).x.push_back(std::abs(pub));
       (pub * got > 0 ? pub_vs : neg_vs).y.push_back(std::abs(got));
     }
@@ -146,7 +148,8 @@ TargetResult gurkan_table43(const Context& ctx) {
     all_agree += agree;
     all_within1 += within1;
     all_abs_agree += abs_agree;
-    (cplx ? max_cplx_norm : min_real_norm) = cplx ? std::max(max_cplx_norm, row->norm) : std::min(min_real_norm, row->norm);
+    (cplx ? max_cplx_norm : min_real_norm) =
+        cplx ? std::max(max_cplx_norm, row->norm) : std::min(min_real_norm, row->norm);
     min_norm = std::min(min_norm, row->norm);
 
     Claim c;
@@ -155,16 +158,17 @@ TargetResult gurkan_table43(const Context& ctx) {
                           show(p.x[1]), show(p.x[2]), show(p.x[3]), show(p.x[4]), p.norm);
     c.published = p.norm;
     c.measured = row->norm;
-    c.measured_text = fmt::format("norm {:.4g}; X11 {}, X16 {}, X17 {}, X19 {}, X20 {}; {} of 6 printed values agree "
-                                  "digit by digit{}",
-                                  row->norm, show_full(val.at("X11"), cplx), show_full(val.at("X16"), cplx),
-                                  show_full(val.at("X17"), cplx), show_full(val.at("X19"), cplx),
-                                  show_full(val.at("X20"), cplx), agree,
-                                  opposite ? fmt::format(" ({} of 5 with the opposite sign)", opposite) : "");
+    c.measured_text = fmt::format(
+        "norm {:.4g}; X11 {}, X16 {}, X17 {}, X19 {}, X20 {}; {} of 6 printed values agree "
+        "digit by digit{}",
+        row->norm, show_full(val.at("X11"), cplx), show_full(val.at("X16"), cplx), show_full(val.at("X17"), cplx),
+        show_full(val.at("X19"), cplx), show_full(val.at("X20"), cplx), agree,
+        opposite ? fmt::format(" ({} of 5 with the opposite sign)", opposite) : "");
     c.criterion = "all six printed values reproduced when the computed ones are rounded to the printed digits";
     c.holds = agree == 6;
-    c.qualitative = std::string("the norm agrees to the printed digits (+-1 in the last) and every |X_i| to +-1 in the "
-                                "last printed digit; the terms are ") +
+    c.qualitative = std::string(
+                        "the norm agrees to the printed digits (+-1 in the last) and every |X_i| to +-1 in the "
+                        "last printed digit; the terms are ") +
                     (cplx ? "purely imaginary" : "real");
     int abs_within1 = 0;
     for (std::size_t k = 0; k < kTerms.size(); ++k)
@@ -175,8 +179,9 @@ TargetResult gurkan_table43(const Context& ctx) {
       character = character && std::abs(other_part(p.x[0], v)) <= 1e-9 * std::max(1e-300, std::abs(v));
     c.qualitative_holds = std::abs(noff) <= 1 && abs_within1 == 5 && character;
     if (std::string(p.method) == "AC2" && opposite == 5)
-      c.measured_text += "; the printed AC2 row is that of the adjoint method (for this skew-symmetric method, its "
-                         "complex conjugate), whose X_i change sign: the magnitudes agree";
+      c.measured_text +=
+          "; the printed AC2 row is that of the adjoint method (for this skew-symmetric method, its "
+          "complex conjugate), whose X_i change sign: the magnitudes agree";
     row_claims.push_back(c);
   }
   write_file_atomic(ctx.path(res.name + ".csv"), csv);
@@ -210,10 +215,9 @@ TargetResult gurkan_table43(const Context& ctx) {
     res.claims.push_back(c);
   }
   {
-    Claim c = band_claim("imaginary_leading",
-                         "the complex methods of Table 4.2 have purely imaginary leading order errors (sec. 4)", 0,
-                         worst_imag_real, 0, 1e-9, "the real parts of X_i of AC1, AC2, BC1, BC2 vanish",
-                         worst_imag_real <= 1e-9);
+    Claim c = band_claim(
+        "imaginary_leading", "the complex methods of Table 4.2 have purely imaginary leading order errors (sec. 4)", 0,
+        worst_imag_real, 0, 1e-9, "the real parts of X_i of AC1, AC2, BC1, BC2 vanish", worst_imag_real <= 1e-9);
     c.measured_text = fmt::format("largest |Re X_i| / |X_i| = {:.2g} (real methods: largest |Im| / |.| = {:.2g})",
                                   worst_imag_real, worst_real_imag);
     c.criterion = "largest |Re X_i| / |X_i| <= 1e-9";
@@ -230,12 +234,12 @@ TargetResult gurkan_table43(const Context& ctx) {
     res.claims.push_back(c);
   }
   {
-    Claim c = band_claim("ac16_norm",
-                         "AC1-6 (eq. 6.1) has an error (sum |X_i|^2)^(1/2) = 2.6e-7, about two orders of magnitude "
-                         "smaller than the other methods",
-                         kPublishedAc16Norm, ac16_norm, 2.55e-7, 2.65e-7,
-                         "AC1-6's norm is more than 30x below that of every method of Table 4.3",
-                         ac16_norm * 30 < min_norm);
+    Claim c =
+        band_claim("ac16_norm",
+                   "AC1-6 (eq. 6.1) has an error (sum |X_i|^2)^(1/2) = 2.6e-7, about two orders of magnitude "
+                   "smaller than the other methods",
+                   kPublishedAc16Norm, ac16_norm, 2.55e-7, 2.65e-7,
+                   "AC1-6's norm is more than 30x below that of every method of Table 4.3", ac16_norm * 30 < min_norm);
     c.measured_text = fmt::format("{:.4g} (smallest of Table 4.3: {:.3g}, {:.0f}x larger)", ac16_norm, min_norm,
                                   min_norm / ac16_norm);
     c.criterion = "rounds to the printed 2.6e-7";

@@ -13,8 +13,8 @@
 #include <fmt/core.h>
 
 #include "cli.hpp"
-#include "reproduce.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "reproduce.hpp"
 
 namespace nystrom::cli::reproduce {
 
@@ -41,8 +41,8 @@ std::string grid_csv(const std::vector<GridRow>& rows) {
   bool header = true;
   std::size_t i = 0;
   while (std::getline(in, line)) {
-    out += (header ? std::string("nominal_force_evals_per_period") : fmt::format("{:.17g}", rows[i++].nominal_n)) + "," +
-           line + "\n";
+    out += (header ? std::string("nominal_force_evals_per_period") : fmt::format("{:.17g}", rows[i++].nominal_n)) +
+           "," + line + "\n";
     header = false;
   }
   return out;
@@ -72,11 +72,13 @@ TargetResult fig1(const Context& ctx) {
   res.precision = "long-double";
   const std::vector<std::string> methods{"FR", "N4", "Aprime", "M4"};
   std::vector<double> eccs;
-  if (ctx.quick) eccs = {0.4, 0.6, 0.8, 0.9};
+  if (ctx.quick)
+    eccs = {0.4, 0.6, 0.8, 0.9};
   else
     for (int i = 0; i <= 10; ++i) eccs.push_back(0.4 + 0.05 * i);
   // h = 2 pi / n; the paper sees convergence near n = 3000 and uses n = 5000 (text after eq 38).
-  const std::vector<long> ns = ctx.quick ? std::vector<long>{3000, 5000} : std::vector<long>{1000, 2000, 3000, 5000, 8000};
+  const std::vector<long> ns =
+      ctx.quick ? std::vector<long>{3000, 5000} : std::vector<long>{1000, 2000, 3000, 5000, 8000};
   const long n_final = 5000;
 
   struct Row {
@@ -116,8 +118,8 @@ TargetResult fig1(const Context& ctx) {
 
   std::string csv = "method,ecc,steps_per_period,h,precession_per_period,e_P\n";
   for (const auto& r : rows)
-    csv += fmt::format("{},{:.2f},{},{:.17g},{:.17g},{:.17g}\n", r.method, r.ecc, r.n, 2 * kPi / static_cast<double>(r.n),
-                       r.dtheta, r.eP);
+    csv += fmt::format("{},{:.2f},{},{:.17g},{:.17g},{:.17g}\n", r.method, r.ecc, r.n,
+                       2 * kPi / static_cast<double>(r.n), r.dtheta, r.eP);
   write_file_atomic(ctx.path(res.name + ".csv"), csv);
   res.files.push_back(res.name + ".csv");
 
@@ -142,14 +144,15 @@ TargetResult fig1(const Context& ctx) {
   res.interpretation = {
       "e_P = (precession of the Laplace-Runge-Lenz vector over one period) / h^4, h = 2 pi / n, counter-clockwise "
       "positive (the direction of the orbit); the sign convention reproduces the published signs.",
-      fmt::format("h is refined over n = {}; the value reported is the paper's, n = {} steps per period; "
-                  "stability is the relative change of e_P from n = 3000 to n = 5000.",
-                  [&] {
-                    std::string s;
-                    for (long n : ns) s += (s.empty() ? "" : ", ") + std::to_string(n);
-                    return s;
-                  }(),
-                  n_final),
+      fmt::format(
+          "h is refined over n = {}; the value reported is the paper's, n = {} steps per period; "
+          "stability is the relative change of e_P from n = 3000 to n = 5000.",
+          [&] {
+            std::string s;
+            for (long n : ns) s += (s.empty() ? "" : ", ") + std::to_string(n);
+            return s;
+          }(),
+          n_final),
       "The plot shows |e_P| on a logarithmic axis; the legend gives the sign. FR is the position-first Forest-Ruth "
       "form, A' the forward algorithm 4A with its force gradient replaced by a force at a shifted position.",
       "Long double suffices: at n = 5000 the smallest precession measured (e = 0.4) is ~1e-11 rad, far above the "
@@ -172,9 +175,8 @@ TargetResult fig1(const Context& ctx) {
   const std::map<std::string, double> published{{"FR", -23.1e4}, {"N4", 7.1e4}, {"Aprime", -1.4e4}, {"M4", -1.1e4}};
   for (const auto& m : methods) {
     const double p = published.at(m), v = eP(m, 0.9, n_final);
-    Claim c = band_claim("eP_0.9_" + m,
-                         fmt::format("e_P at e = 0.9 for {} is {:.1f} x 10^4", label_of(m), p / 1e4), p, v,
-                         p - 0.1e4, p + 0.1e4, "same sign and within 10% of the published value",
+    Claim c = band_claim("eP_0.9_" + m, fmt::format("e_P at e = 0.9 for {} is {:.1f} x 10^4", label_of(m), p / 1e4), p,
+                         v, p - 0.1e4, p + 0.1e4, "same sign and within 10% of the published value",
                          std::isfinite(v) && v * p > 0 && std::abs(v / p - 1) < 0.1);
     c.measured_text = fmt::format("{:.2f} x 10^4", v / 1e4);
     c.criterion = "within one unit of the last published digit (0.1 x 10^4)";
@@ -189,9 +191,9 @@ TargetResult fig1(const Context& ctx) {
       hi = std::max(hi, g);
       text += fmt::format("{}{} {:.2f}", text.empty() ? "" : ", ", label_of(m), g);
     }
-    Claim c = band_claim("growth_0.4_0.9", "e_P grows steeply with e, by four orders of magnitude from e = 0.4 to e = 0.9",
-                         4.0, lo, 3.5, 4.5, "|e_P| grows by more than three decades from e = 0.4 to 0.9 for every method",
-                         lo > 3);
+    Claim c = band_claim("growth_0.4_0.9",
+                         "e_P grows steeply with e, by four orders of magnitude from e = 0.4 to e = 0.9", 4.0, lo, 3.5,
+                         4.5, "|e_P| grows by more than three decades from e = 0.4 to 0.9 for every method", lo > 3);
     c.holds = lo >= 3.5 && hi <= 4.5;
     c.criterion = "log10(e_P(0.9) / e_P(0.4)) within 4 +- 0.5 for every method";
     c.measured_text = "decades: " + text;
@@ -210,12 +212,11 @@ TargetResult fig1(const Context& ctx) {
     }
     const double fr = std::abs(eP("FR", 0.9, n_final) / eP("M4", 0.9, n_final));
     const double nn = std::abs(eP("N4", 0.9, n_final) / eP("M4", 0.9, n_final));
-    Claim c = band_claim("m4_better",
-                         "M4 is so much better than FR and N (published at e = 0.9: |FR/M4| = 21, |N/M4| = 6.5)",
-                         23.1 / 1.1, fr, 21.0 / 1.5, 21.0 * 1.5, "|e_P| of M4 is below those of FR and N at every e",
-                         worst > 1);
-    c.measured_text = fmt::format("at e = 0.9: |FR/M4| = {:.3g}, |N/M4| = {:.3g}; smallest ratio over all e {:.3g}", fr, nn,
-                                  worst);
+    Claim c = band_claim(
+        "m4_better", "M4 is so much better than FR and N (published at e = 0.9: |FR/M4| = 21, |N/M4| = 6.5)",
+        23.1 / 1.1, fr, 21.0 / 1.5, 21.0 * 1.5, "|e_P| of M4 is below those of FR and N at every e", worst > 1);
+    c.measured_text =
+        fmt::format("at e = 0.9: |FR/M4| = {:.3g}, |N/M4| = {:.3g}; smallest ratio over all e {:.3g}", fr, nn, worst);
     c.holds = fr >= 21.0 / 1.5 && fr <= 21.0 * 1.5 && nn >= 6.5 / 1.5 && nn <= 6.5 * 1.5 && worst > 1;
     c.criterion = "both ratios at e = 0.9 within a factor 1.5 of the published ones, and M4 best at every e";
     res.claims.push_back(c);
@@ -224,8 +225,9 @@ TargetResult fig1(const Context& ctx) {
     double worst = 0;
     for (const auto& m : methods)
       for (double e : eccs) worst = std::max(worst, std::abs(eP(m, e, 5000) / eP(m, e, 3000) - 1));
-    Claim c = band_claim("converged_3000", "the limit (38) converges near h = 2 pi/3000; the final value uses h = 2 pi/5000",
-                         nan, worst, 0, 0.01, "e_P changes by less than 5% from n = 3000 to n = 5000", worst < 0.05);
+    Claim c =
+        band_claim("converged_3000", "the limit (38) converges near h = 2 pi/3000; the final value uses h = 2 pi/5000",
+                   nan, worst, 0, 0.01, "e_P changes by less than 5% from n = 3000 to n = 5000", worst < 0.05);
     c.criterion = "largest relative change of e_P from n = 3000 to 5000 <= 1%";
     c.measured_text = fmt::format("{:.2g}%", 100 * worst);
     res.claims.push_back(c);
@@ -301,23 +303,24 @@ TargetResult fig2(const Context& ctx) {
   res.table = errors_table(rows, methods, ctx.quick ? ns : std::vector<double>{1e4, N5, 1e6});
   const double y6 = error_at(rows, "Y6", N5), kl6 = error_at(rows, "KL6", N5), a6 = error_at(rows, "A6", N5),
                m6 = error_at(rows, "M6", N5);
-  res.claims.push_back(ratio_claim("kl6_over_y6", "at N = 10^5 KL6's error is only half of Y6's", kl6, y6, 0.5, 0.25, 1.0,
-                                   "KL6's error is below Y6's", kl6 < y6));
-  res.claims.push_back(ratio_claim("kl6_over_a6", "at N = 10^5 KL6's error is nearly 50 times that of A6", kl6, a6, 50, 25,
-                                   100, "A6's error is below KL6's", a6 < kl6));
-  res.claims.push_back(ratio_claim("kl6_over_m6", "at N = 10^5 KL6's error is nearly 50 times that of M6", kl6, m6, 50, 25,
-                                   100, "M6's error is below KL6's", m6 < kl6));
-  res.claims.push_back(ratio_claim("y6_over_a6", "at N = 10^5 Y6's error is nearly 100 times that of A6", y6, a6, 100, 50,
-                                   200, "A6's error is below Y6's", a6 < y6));
-  res.claims.push_back(ratio_claim("y6_over_m6", "at N = 10^5 Y6's error is nearly 100 times that of M6", y6, m6, 100, 50,
-                                   200, "M6's error is below Y6's", m6 < y6));
+  res.claims.push_back(ratio_claim("kl6_over_y6", "at N = 10^5 KL6's error is only half of Y6's", kl6, y6, 0.5, 0.25,
+                                   1.0, "KL6's error is below Y6's", kl6 < y6));
+  res.claims.push_back(ratio_claim("kl6_over_a6", "at N = 10^5 KL6's error is nearly 50 times that of A6", kl6, a6, 50,
+                                   25, 100, "A6's error is below KL6's", a6 < kl6));
+  res.claims.push_back(ratio_claim("kl6_over_m6", "at N = 10^5 KL6's error is nearly 50 times that of M6", kl6, m6, 50,
+                                   25, 100, "M6's error is below KL6's", m6 < kl6));
+  res.claims.push_back(ratio_claim("y6_over_a6", "at N = 10^5 Y6's error is nearly 100 times that of A6", y6, a6, 100,
+                                   50, 200, "A6's error is below Y6's", a6 < y6));
+  res.claims.push_back(ratio_claim("y6_over_m6", "at N = 10^5 Y6's error is nearly 100 times that of M6", y6, m6, 100,
+                                   50, 200, "M6's error is below Y6's", m6 < y6));
   return res;
 }
 
 TargetResult fig3(const Context& ctx) {
   TargetResult res;
   res.name = "chin-fig3";
-  res.title = "Precession error against force evaluations, e = 0.9: KL8, SS10, DP10, DP12 and the minimal MPE integrators";
+  res.title =
+      "Precession error against force evaluations, e = 0.9: KL8, SS10, DP10, DP12 and the minimal MPE integrators";
   res.paper = "Chin (2010), Fig. 3 and the text of sec. V";
   res.quick = ctx.quick;
   res.precision = ctx.quad;
@@ -328,8 +331,8 @@ TargetResult fig3(const Context& ctx) {
   if (ctx.quick) {
     // the claims at N = 1e5, and a coarse envelope
     rows = kepler_grid(res.name + " N=1e5", {"KL8", "SS10", "DP10", "DP12"}, {N5}, 0.9, ctx.quad);
-    const auto env = kepler_grid(res.name + " envelope", mpe, {std::pow(10.0, 3.5), 1e4, std::pow(10.0, 4.5), N5}, 0.9,
-                                 ctx.quad);
+    const auto env =
+        kepler_grid(res.name + " envelope", mpe, {std::pow(10.0, 3.5), 1e4, std::pow(10.0, 4.5), N5}, 0.9, ctx.quad);
     rows.insert(rows.end(), env.begin(), env.end());
   } else {
     std::vector<std::string> all = others;
@@ -416,16 +419,16 @@ TargetResult fig3(const Context& ctx) {
   const double kl8 = error_at(rows, "KL8", N5), m8 = error_at(rows, "M8", N5), ss10 = error_at(rows, "SS10", N5),
                m10 = error_at(rows, "M10", N5), dp10 = error_at(rows, "DP10", N5), dp12 = error_at(rows, "DP12", N5),
                m12 = error_at(rows, "M12", N5), m14 = error_at(rows, "M14", N5);
-  res.claims.push_back(ratio_claim("kl8_over_m8", "at N = 10^5 the error of KL8 is more than 300 times that of M8", kl8, m8,
-                                   300, 300, kInf, "M8's error is below KL8's", m8 < kl8));
-  res.claims.push_back(ratio_claim("ss10_over_m10", "at N = 10^5 the error of SS10 is about 100 times that of M10", ss10,
-                                   m10, 100, 50, 200, "M10's error is below SS10's", m10 < ss10));
+  res.claims.push_back(ratio_claim("kl8_over_m8", "at N = 10^5 the error of KL8 is more than 300 times that of M8", kl8,
+                                   m8, 300, 300, kInf, "M8's error is below KL8's", m8 < kl8));
+  res.claims.push_back(ratio_claim("ss10_over_m10", "at N = 10^5 the error of SS10 is about 100 times that of M10",
+                                   ss10, m10, 100, 50, 200, "M10's error is below SS10's", m10 < ss10));
   res.claims.push_back(ratio_claim("dp10_over_m10", "DP10 is comparable to M10 (at N = 10^5)", dp10, m10, 1, 1.0 / 3, 3,
                                    "DP10 and M10 within a factor 10", dp10 / m10 > 0.1 && dp10 / m10 < 10));
-  res.claims.push_back(ratio_claim("m12_over_dp12", "DP12's error at N = 10^5 is 10 times smaller than M12's", m12, dp12, 10,
-                                   5, 20, "DP12's error is below M12's", dp12 < m12));
-  res.claims.push_back(ratio_claim("dp12_over_m14", "M14's error is 100 times smaller than DP12's at N = 10^5", dp12, m14,
-                                   100, 50, 200, "M14's error is below DP12's", m14 < dp12));
+  res.claims.push_back(ratio_claim("m12_over_dp12", "DP12's error at N = 10^5 is 10 times smaller than M12's", m12,
+                                   dp12, 10, 5, 20, "DP12's error is below M12's", dp12 < m12));
+  res.claims.push_back(ratio_claim("dp12_over_m14", "M14's error is 100 times smaller than DP12's at N = 10^5", dp12,
+                                   m14, 100, 50, 200, "M14's error is below DP12's", m14 < dp12));
   {
     // The envelope above the rounding floor: the best order grows along N, and the envelope steepens.
     std::vector<EnvPoint> valid;
@@ -455,17 +458,18 @@ TargetResult fig3(const Context& ctx) {
     Claim c = band_claim("envelope_steeper",
                          "the most efficient integrator is never a fixed order: the enveloping error curve is steeper "
                          "than any fixed order integrator",
-                         nan, s_last - s_first, 0, kInf, "the best MPE order at the largest N exceeds that at the smallest",
-                         last_order > first_order);
+                         nan, s_last - s_first, 0, kInf,
+                         "the best MPE order at the largest N exceeds that at the smallest", last_order > first_order);
     c.holds = last_order > first_order && (ctx.quick || s_last > s_first);
     c.measured_text = fmt::format(
         "best order {} at N = {:.3g} rising to {} at N = {:.3g} ({} step(s) down on the way, at sign changes of the "
         "error); envelope slope {} over the first decade, {} over the last",
         first_order, n_lo, last_order, n_hi, drops, fmt_g(s_first), fmt_g(s_last));
-    c.criterion = ctx.quick ? "above the rounding floor (error > 1e-28): the best order rises (quick run: too few "
-                              "points for slopes)"
-                            : "above the rounding floor (error > 1e-28): the best order rises and the envelope's fitted "
-                              "slope over the last decade exceeds that over the first";
+    c.criterion = ctx.quick
+                      ? "above the rounding floor (error > 1e-28): the best order rises (quick run: too few "
+                        "points for slopes)"
+                      : "above the rounding floor (error > 1e-28): the best order rises and the envelope's fitted "
+                        "slope over the last decade exceeds that over the first";
     res.claims.push_back(c);
   }
   if (!ctx.quick) {
@@ -476,10 +480,9 @@ TargetResult fig3(const Context& ctx) {
         floor.push_back(std::abs(g.row.report.precession_per_period));
     std::sort(floor.begin(), floor.end());
     const double med = floor.empty() ? nan : floor[floor.size() / 2];
-    Claim c = band_claim("quad_floor",
-                         "the highest order is 16 because quadruple precision is inadequate for precision below 1e-30",
-                         1e-30, med, 1e-31, 1e-29, "M14 and M16 level off at a rounding floor below 1e-28",
-                         med < 1e-28);
+    Claim c = band_claim(
+        "quad_floor", "the highest order is 16 because quadruple precision is inadequate for precision below 1e-30",
+        1e-30, med, 1e-31, 1e-29, "M14 and M16 level off at a rounding floor below 1e-28", med < 1e-28);
     c.criterion = "median |dtheta| of M14 and M16 at N > 1.5e5 (on the floor) within a decade of 1e-30";
     res.claims.push_back(c);
   }

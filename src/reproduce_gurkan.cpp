@@ -15,8 +15,8 @@
 #include <fmt/core.h>
 
 #include "cli.hpp"
-#include "reproduce.hpp"
 #include "nystrom/experiments/localerr.hpp"
+#include "reproduce.hpp"
 
 namespace nystrom::cli::reproduce {
 
@@ -30,8 +30,8 @@ struct Shown {
   std::string method, label;
   int point;
 };
-const std::vector<Shown> kMethods{{"VV", "Leapfrog", 11},  {"Y4", "Triple jump", 1}, {"Chambers", "Chambers", 9},
-                                  {"RKNb6", "RKNb6", 3},   {"RKNa14", "RKNa14", 7},  {"BR1", "RKNbr1", 15},
+const std::vector<Shown> kMethods{{"VV", "Leapfrog", 11}, {"Y4", "Triple jump", 1}, {"Chambers", "Chambers", 9},
+                                  {"RKNb6", "RKNb6", 3},  {"RKNa14", "RKNa14", 7},  {"BR1", "RKNbr1", 15},
                                   {"AC1", "RKNac1", 5}};
 
 std::string label_of(const std::string& m) {
@@ -82,8 +82,8 @@ LocalErrResult localerr(const std::string& label, LocalErrConfig cfg) {
 std::string localerr_csv(const LocalErrResult& r) {
   std::string text = "method,h,h_time,steps,samples,q25,q75,iqr\n";
   for (const auto& x : r.rows)
-    text += fmt::format("{},{:.17g},{:.17g},{},{},{:.17g},{:.17g},{:.17g}\n", x.method, x.h, x.h_time, x.steps, x.samples,
-                        x.q25, x.q75, x.iqr);
+    text += fmt::format("{},{:.17g},{:.17g},{},{},{:.17g},{:.17g},{:.17g}\n", x.method, x.h, x.h_time, x.steps,
+                        x.samples, x.q25, x.q75, x.iqr);
   return text;
 }
 
@@ -194,7 +194,8 @@ TargetResult fig51(const Context& ctx) {
   write_file_atomic(ctx.path(res.name + ".csv"), localerr_csv(r));
   res.files.push_back(res.name + ".csv");
   plot_loglog(ctx.path(res.name + ".png"), "Gurkan Fig. 5.1: two-body problem, e = 0.2, 50 periods",
-              "time step h (orbital periods)", "interquartile range of the position error", localerr_series(r, cfg.methods));
+              "time step h (orbital periods)", "interquartile range of the position error",
+              localerr_series(r, cfg.methods));
   res.files.push_back(res.name + ".png");
   res.interpretation = {
       "Two equal masses on an e = 0.2 orbit (period 2 pi) for 50 periods. The reference is followed with "
@@ -210,9 +211,9 @@ TargetResult fig51(const Context& ctx) {
   res.table = orders_table(r, cfg.methods);
 
   const double och = observed_order(r, "Chambers"), oac = observed_order(r, "AC1");
-  Claim c1 = band_claim("chambers_order", "the method of Chambers (formally third order) shows fourth-order behaviour", 4,
-                        och, 3.7, 4.3, "Chambers' observed order exceeds its formal order 3 by more than half an order",
-                        och > 3.5);
+  Claim c1 =
+      band_claim("chambers_order", "the method of Chambers (formally third order) shows fourth-order behaviour", 4, och,
+                 3.7, 4.3, "Chambers' observed order exceeds its formal order 3 by more than half an order", och > 3.5);
   c1.measured_text = "observed order " + fmt_g(och);
   res.claims.push_back(c1);
   Claim c2 = band_claim("ac1_order", "RKNac1 (formally fifth order) shows sixth-order behaviour", 6, oac, 5.7, 6.3,
@@ -227,10 +228,10 @@ TargetResult fig51(const Context& ctx) {
       worst = std::min(worst, row.iqr / iqr_at(r, "RKNb6", row.h));
       ++compared;
     }
-    Claim c = band_claim("rknb6_beats_br1",
-                         "the optimized fourth-order RKNb6 outperforms the higher-order RKNbr1 down to machine accuracy",
-                         nan, worst, 1, kInf, "RKNb6's IQR is below RKNbr1's at every step size above the floor",
-                         compared > 0 && worst > 1);
+    Claim c = band_claim(
+        "rknb6_beats_br1",
+        "the optimized fourth-order RKNb6 outperforms the higher-order RKNbr1 down to machine accuracy", nan, worst, 1,
+        kInf, "RKNb6's IQR is below RKNbr1's at every step size above the floor", compared > 0 && worst > 1);
     c.measured_text = fmt::format("smallest IQR(RKNbr1) / IQR(RKNb6) over {} step sizes: {}", compared, fmt_g(worst));
     c.criterion = "ratio > 1 at every h where RKNbr1's IQR > 1e-13";
     res.claims.push_back(c);
@@ -274,9 +275,9 @@ TargetResult fig52(const Context& ctx) {
       lo = std::min(lo, q);
       hi = std::max(hi, q);
     }
-    Claim c = band_claim("tj_coincides_chambers", "Triple jump nearly coincides with Chambers for this problem", 1, hi, 0,
-                         2, "Triple jump and Chambers agree within a factor 3 at every h",
-                         lo >= 1.0 / 3 && hi <= 3 && hi > 0);
+    Claim c =
+        band_claim("tj_coincides_chambers", "Triple jump nearly coincides with Chambers for this problem", 1, hi, 0, 2,
+                   "Triple jump and Chambers agree within a factor 3 at every h", lo >= 1.0 / 3 && hi <= 3 && hi > 0);
     c.holds = lo >= 0.5 && hi <= 2;
     c.measured_text = fmt::format("IQR(Triple jump) / IQR(Chambers) between {} and {}", fmt_g(lo), fmt_g(hi));
     c.criterion = "every ratio within [0.5, 2]";
@@ -343,7 +344,8 @@ TargetResult table51(const Context& ctx) {
       "Timings depend on the machine and its load; the claims below are reported but not asserted by the tests.",
       "\"Holds\" for a ratio means within a factor 1.5 of the published one; the stage-proportionality claim uses "
       "the real methods (time per step / forces per step within [0.7, 1.3] of the leapfrog's)."};
-  std::string t = "| method | forces/step | complex | s/step | measured / leapfrog | published |\n|---|---|---|---|---|---|\n";
+  std::string t =
+      "| method | forces/step | complex | s/step | measured / leapfrog | published |\n|---|---|---|---|---|---|\n";
   t += fmt::format("| Leapfrog | 1 | no | {:.4g} | 1 | 1 |\n", r.leapfrog_seconds);
   for (const auto& row : r.rows)
     t += fmt::format("| {} | {} | {} | {:.4g} | {:.3g} | {} |\n", label_of(row.method), row.forces_per_step,
@@ -351,8 +353,9 @@ TargetResult table51(const Context& ctx) {
   res.table = t;
   for (const auto& row : r.rows) {
     const double p = kPublishedCost.at(row.method);
-    Claim c = band_claim("cost_" + row.method, fmt::format("{} costs {} leapfrog steps per step", label_of(row.method), p),
-                         p, row.ratio, p / 1.5, p * 1.5, "costs more than the leapfrog", row.ratio > 1);
+    Claim c =
+        band_claim("cost_" + row.method, fmt::format("{} costs {} leapfrog steps per step", label_of(row.method), p), p,
+                   row.ratio, p / 1.5, p * 1.5, "costs more than the leapfrog", row.ratio > 1);
     c.timing = true;
     res.claims.push_back(c);
   }
@@ -371,9 +374,9 @@ TargetResult table51(const Context& ctx) {
     }
   }
   {
-    Claim c = band_claim("proportional_to_stages", "the integration time is proportional to the number of stages", 1, hi,
-                         0.7, 1.3, "the real methods cost between half and twice a leapfrog step per force",
-                         lo >= 0.5 && hi <= 2);
+    Claim c =
+        band_claim("proportional_to_stages", "the integration time is proportional to the number of stages", 1, hi, 0.7,
+                   1.3, "the real methods cost between half and twice a leapfrog step per force", lo >= 0.5 && hi <= 2);
     c.holds = lo >= 0.7 && hi <= 1.3;
     c.measured_text = fmt::format("time per force / leapfrog's between {} and {} (real methods)", fmt_g(lo), fmt_g(hi));
     c.criterion = "every ratio within [0.7, 1.3]";
@@ -382,8 +385,8 @@ TargetResult table51(const Context& ctx) {
   }
   {
     const double factor = (cplx_per_force / ncplx) / (real_per_force / nreal);
-    Claim c = band_claim("complex_factor", "complex arithmetic increases the computation cost by about a factor of 6", 6,
-                         factor, 3, 12, "a complex force evaluation costs more than a real one", factor > 1.5);
+    Claim c = band_claim("complex_factor", "complex arithmetic increases the computation cost by about a factor of 6",
+                         6, factor, 3, 12, "a complex force evaluation costs more than a real one", factor > 1.5);
     c.measured_text = fmt::format("factor {} (time per force, complex / real methods)", fmt_g(factor));
     c.timing = true;
     res.claims.push_back(c);
@@ -446,8 +449,8 @@ TargetResult fig53(const Context& ctx) {
       "when the error is outside a method's range).",
       "These claims depend on timings (machine, load) and are not asserted by the tests."};
   const double target = 1e-10;
-  std::string tb = fmt::format("CPU time (leapfrog steps at h = 0.01) to reach IQR = {:g}:\n\n| method | cost |\n|---|---|\n",
-                               target);
+  std::string tb = fmt::format(
+      "CPU time (leapfrog steps at h = 0.01) to reach IQR = {:g}:\n\n| method | cost |\n|---|---|\n", target);
   std::map<std::string, double> cost;
   for (const auto& s : kMethods) {
     cost[s.method] = cost_for(pts[s.method], target);
@@ -457,11 +460,10 @@ TargetResult fig53(const Context& ctx) {
   {
     const double ac = cost["AC1"];
     const double best_lower = std::min({cost["Chambers"], cost["Y4"], cost["VV"]});
-    Claim c = band_claim("ac1_competitive",
-                         "the complex fifth-order methods are already competitive with lower order methods", nan,
-                         best_lower / ac, 1, kInf,
-                         "RKNac1 reaches IQR 1e-10 for less CPU time than Chambers, Triple jump and the leapfrog",
-                         ac < best_lower);
+    Claim c = band_claim(
+        "ac1_competitive", "the complex fifth-order methods are already competitive with lower order methods", nan,
+        best_lower / ac, 1, kInf,
+        "RKNac1 reaches IQR 1e-10 for less CPU time than Chambers, Triple jump and the leapfrog", ac < best_lower);
     c.measured_text = fmt::format("cost to IQR 1e-10: RKNac1 {}, Chambers {}, Triple jump {}, Leapfrog {}", fmt_g(ac),
                                   fmt_g(cost["Chambers"]), fmt_g(cost["Y4"]), fmt_g(cost["VV"]));
     c.criterion = "cost of the cheapest lower-order method / RKNac1's >= 1";

@@ -49,7 +49,7 @@ MethodDef gbs_method() {
   d.info.adaptive = true;
   d.info.source = "Gragg (1965); Bulirsch & Stoer (1966); Hairer, Norsett & Wanner I, sec. II.9/II.14 (ODEX2)";
   d.info.description = "Gragg-Bulirsch-Stoer extrapolation, adaptive step and order";
-  d.build = [] () -> MethodData { throw std::invalid_argument("GBS has no coefficient table"); };
+  d.build = []() -> MethodData { throw std::invalid_argument("GBS has no coefficient table"); };
   return d;
 }
 

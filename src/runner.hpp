@@ -17,15 +17,15 @@ struct RunRequest {
   long steps_per_period = 1000;    // steps per orbital period
   long periods = 10;               // whole periods integrated
   std::string precision = "double";
-  bool keep_complex = false;       // complex methods: keep the complexified state
-  double tol = 0;                  // adaptive methods: tolerance (required for them, refused otherwise)
+  bool keep_complex = false;  // complex methods: keep the complexified state
+  double tol = 0;             // adaptive methods: tolerance (required for them, refused otherwise)
   // nbody / twobody (double precision):
-  long n = 400;                    // Plummer particles
-  unsigned long seed = 42;         // Plummer sample
-  std::string ic_file;             // particle file (m x y z vx vy vz per line) instead of a Plummer sphere
-  double eps2 = -1;                // softening squared; < 0: (1/N)^2 for nbody, 0 for twobody
-  double h = 0.01;                 // nbody: step size (time units)
-  long steps = 100;                // nbody: number of steps
+  long n = 400;             // Plummer particles
+  unsigned long seed = 42;  // Plummer sample
+  std::string ic_file;      // particle file (m x y z vx vy vz per line) instead of a Plummer sphere
+  double eps2 = -1;         // softening squared; < 0: (1/N)^2 for nbody, 0 for twobody
+  double h = 0.01;          // nbody: step size (time units)
+  long steps = 100;         // nbody: number of steps
 };
 
 /// The Gragg-Bulirsch-Stoer reference integrator is a method of `run`/`sweep` too, named "GBS"

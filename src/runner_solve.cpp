@@ -27,7 +27,8 @@ double parse_number(const std::string& text, const std::string& what) {
   } catch (const std::exception&) {
     pos = 0;
   }
-  if (pos == 0 || pos != text.size() || !std::isfinite(x)) throw UsageError(what + ": '" + text + "' is not a finite number");
+  if (pos == 0 || pos != text.size() || !std::isfinite(x))
+    throw UsageError(what + ": '" + text + "' is not a finite number");
   return x;
 }
 
@@ -52,7 +53,8 @@ std::vector<double> parse_output_times(const std::string& spec) {
   if (n == 1 && t0 != t1) throw UsageError("--output-times: one point needs A = B");
   if (t1 < t0) throw UsageError("--output-times: B must not be before A");
   std::vector<double> t(static_cast<std::size_t>(n));
-  for (long i = 0; i < n; ++i) t[static_cast<std::size_t>(i)] = n == 1 ? t0 : t0 + (t1 - t0) * static_cast<double>(i) / static_cast<double>(n - 1);
+  for (long i = 0; i < n; ++i)
+    t[static_cast<std::size_t>(i)] = n == 1 ? t0 : t0 + (t1 - t0) * static_cast<double>(i) / static_cast<double>(n - 1);
   if (n > 1) t.back() = t1;
   return t;
 }

@@ -17,7 +17,7 @@ struct SolveRequest {
   std::string events;        // comma-separated: pericentre, apocentre, y=0
   std::string checkpoint;    // file written at the first step boundary at or after checkpoint_at
   double checkpoint_at = std::numeric_limits<double>::quiet_NaN();
-  std::string restart;       // checkpoint file to continue from
+  std::string restart;  // checkpoint file to continue from
   bool any() const {
     return !output_times.empty() || !events.empty() || !checkpoint.empty() || !restart.empty() ||
            !std::isnan(checkpoint_at);

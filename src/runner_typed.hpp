@@ -52,10 +52,10 @@ RunReport run_in_precision(const RunRequest& req, const MethodDef& def, bool gbs
   if (req.problem == "kepler") {
     if (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1)
       throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
-    const auto k = gbs ? run_kepler_gbs<T>(req.ecc, req.tol, req.periods)
-                   : def.info.adaptive
-                       ? run_kepler_adaptive<T>(def, req.ecc, req.tol, req.periods)
-                       : run_kepler<T>(def, req.ecc, req.steps_per_period, req.periods, EngineOptions{req.keep_complex});
+    const auto k = gbs                 ? run_kepler_gbs<T>(req.ecc, req.tol, req.periods)
+                   : def.info.adaptive ? run_kepler_adaptive<T>(def, req.ecc, req.tol, req.periods)
+                                       : run_kepler<T>(def, req.ecc, req.steps_per_period, req.periods,
+                                                       EngineOptions{req.keep_complex});
     RunReport out;
     out.ecc = req.ecc;
     out.steps = k.steps;
@@ -76,7 +76,6 @@ RunReport run_in_precision(const RunRequest& req, const MethodDef& def, bool gbs
   throw UsageError("unknown problem '" + req.problem + "' (known: " + known + ")");
 }
 
-#define NYSTROM_RUNNER_INSTANTIATE(T) \
-  template RunReport run_in_precision<T>(const RunRequest&, const MethodDef&, bool);
+#define NYSTROM_RUNNER_INSTANTIATE(T) template RunReport run_in_precision<T>(const RunRequest&, const MethodDef&, bool);
 
 }  // namespace nystrom::cli

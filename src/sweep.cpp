@@ -105,8 +105,8 @@ std::string sweep_csv(const std::vector<SweepRow>& rows) {
   out.precision(17);
   for (const auto& r : rows) {
     const auto& p = r.report;
-    out << p.method << "," << p.family << "," << p.order << "," << p.precision << "," << p.problem << "," << p.ecc << ","
-        << r.force_evals_per_period << "," << p.steps << "," << p.force_evals << "," << p.h << ","
+    out << p.method << "," << p.family << "," << p.order << "," << p.precision << "," << p.problem << "," << p.ecc
+        << "," << r.force_evals_per_period << "," << p.steps << "," << p.force_evals << "," << p.h << ","
         << p.precession_per_period << "," << p.energy_error << "," << p.position_error << "," << p.seconds << "\n";
   }
   return out.str();

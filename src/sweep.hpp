@@ -14,11 +14,11 @@ struct SweepRow {
 };
 
 struct SweepRequest {
-  RunRequest base;                     // problem, ecc, periods, precision
+  RunRequest base;  // problem, ecc, periods, precision
   std::vector<std::string> methods;
-  std::vector<double> force_evals;     // target force evaluations per period
-  std::vector<double> tols;            // adaptive methods run once per tolerance instead
-  double t_end = 1.0;                  // nbody: the time span of every run (N counts forces over it)
+  std::vector<double> force_evals;  // target force evaluations per period
+  std::vector<double> tols;         // adaptive methods run once per tolerance instead
+  double t_end = 1.0;               // nbody: the time span of every run (N counts forces over it)
 };
 
 /// The work of one run (see check_work_budget): steps x forces per step x the cost of a force of the

@@ -43,7 +43,8 @@ AdaptiveOptions with_tol(double tol) {
 double position_error(const State<V2>& s, double ecc, double t) {
   const KeplerProblem<long double> kp(static_cast<long double>(ecc));
   const auto ex = kp.exact(static_cast<long double>(t));
-  return static_cast<double>(std::hypot(static_cast<long double>(s.q[0]) - ex.q[0], static_cast<long double>(s.q[1]) - ex.q[1]));
+  return static_cast<double>(
+      std::hypot(static_cast<long double>(s.q[0]) - ex.q[0], static_cast<long double>(s.q[1]) - ex.q[1]));
 }
 
 /// One period of Kepler e = 0.5 with the default controller at tolerance tol.
@@ -187,44 +188,42 @@ TEST(AdaptiveMpe, ContinuesAcrossCalls) {
 // not in ascending order.
 TEST(AdaptiveMpe, SchedulesAreBitwiseIdentical) {
   for (const char* spec : {"mpe-adaptive:1,2,3,5", "mpe-vv-adaptive:3,1,5,2"})
-  for (Compensation comp : {Compensation::on, Compensation::off}) {
-    SCOPED_TRACE(spec);
-    auto run_array = [&](MpeSchedule sched) {
-      long calls = 0;
-      EngineOptions eo;
-      eo.compensated = comp;
-      eo.mpe_schedule = sched;
-      auto ai = make_adaptive_mpe_integrator<V2>(resolve_method(spec), CountingKepler{&calls},
-                                                 with_tol(1e-9), eo);
-      EXPECT_EQ(ai.lockstep(), sched != MpeSchedule::sequential);
-      State<V2> s = KeplerProblem<double>(0.9).initial_state();
-      const AdaptiveStats st = ai.integrate_to(s, 0.0, 7.0);
-      return std::pair(s, st.force_evals);
-    };
-    const auto [a, fa] = run_array(MpeSchedule::lockstep);
-    const auto [b, fb] = run_array(MpeSchedule::sequential);
-    EXPECT_EQ(fa, fb);
-    for (int i = 0; i < 2; ++i) {
-      EXPECT_EQ(a.q[i], b.q[i]);
-      EXPECT_EQ(a.v[i], b.v[i]);
-    }
-    for (MpeSchedule sched : {MpeSchedule::lockstep, MpeSchedule::sequential}) {
-      long calls = 0;
-      EngineOptions eo;
-      eo.compensated = comp;
-      eo.mpe_schedule = sched;
-      auto ai = make_adaptive_mpe_integrator<VD>(resolve_method(spec), CountingKepler{&calls},
-                                                 with_tol(1e-9), eo);
-      const auto s0 = KeplerProblem<double>(0.9).initial_state();
-      State<VD> s{{s0.q[0], s0.q[1]}, {s0.v[0], s0.v[1]}};
-      const AdaptiveStats st = ai.integrate_to(s, 0.0, 7.0);
-      EXPECT_EQ(st.force_evals, fa);
+    for (Compensation comp : {Compensation::on, Compensation::off}) {
+      SCOPED_TRACE(spec);
+      auto run_array = [&](MpeSchedule sched) {
+        long calls = 0;
+        EngineOptions eo;
+        eo.compensated = comp;
+        eo.mpe_schedule = sched;
+        auto ai = make_adaptive_mpe_integrator<V2>(resolve_method(spec), CountingKepler{&calls}, with_tol(1e-9), eo);
+        EXPECT_EQ(ai.lockstep(), sched != MpeSchedule::sequential);
+        State<V2> s = KeplerProblem<double>(0.9).initial_state();
+        const AdaptiveStats st = ai.integrate_to(s, 0.0, 7.0);
+        return std::pair(s, st.force_evals);
+      };
+      const auto [a, fa] = run_array(MpeSchedule::lockstep);
+      const auto [b, fb] = run_array(MpeSchedule::sequential);
+      EXPECT_EQ(fa, fb);
       for (int i = 0; i < 2; ++i) {
-        EXPECT_EQ(s.q[i], a.q[i]);
-        EXPECT_EQ(s.v[i], a.v[i]);
+        EXPECT_EQ(a.q[i], b.q[i]);
+        EXPECT_EQ(a.v[i], b.v[i]);
+      }
+      for (MpeSchedule sched : {MpeSchedule::lockstep, MpeSchedule::sequential}) {
+        long calls = 0;
+        EngineOptions eo;
+        eo.compensated = comp;
+        eo.mpe_schedule = sched;
+        auto ai = make_adaptive_mpe_integrator<VD>(resolve_method(spec), CountingKepler{&calls}, with_tol(1e-9), eo);
+        const auto s0 = KeplerProblem<double>(0.9).initial_state();
+        State<VD> s{{s0.q[0], s0.q[1]}, {s0.v[0], s0.v[1]}};
+        const AdaptiveStats st = ai.integrate_to(s, 0.0, 7.0);
+        EXPECT_EQ(st.force_evals, fa);
+        for (int i = 0; i < 2; ++i) {
+          EXPECT_EQ(s.q[i], a.q[i]);
+          EXPECT_EQ(s.v[i], a.v[i]);
+        }
       }
     }
-  }
 }
 
 // A base that starts with a kick (velocity Verlet) shares the force at q_0 among the products: one
@@ -260,7 +259,8 @@ TEST(AdaptiveMpe, BadInputThrows) {
                std::invalid_argument);
   EngineOptions conc;
   conc.mpe_schedule = MpeSchedule::concurrent;
-  EXPECT_THROW(make_adaptive_mpe_integrator<V2>(def, CountingKepler{&calls}, with_tol(1e-8), conc), std::invalid_argument);
+  EXPECT_THROW(make_adaptive_mpe_integrator<V2>(def, CountingKepler{&calls}, with_tol(1e-8), conc),
+               std::invalid_argument);
   auto ai = make_adaptive_mpe_integrator<V2>(def, CountingKepler{&calls}, with_tol(1e-8));
   State<V2> s = KeplerProblem<double>(0.5).initial_state();
   EXPECT_THROW(ai.integrate_to(s, 1.0, 0.0), std::invalid_argument);

@@ -143,7 +143,8 @@ TEST(AdaptiveRkn, RejectsBadInput) {
   // A method without an embedded pair cannot run with a tolerance.
   EXPECT_THROW(make_adaptive_integrator<V2>(resolve_method("DP12"), KeplerForce{}, with_tol(1e-8)),
                std::invalid_argument);
-  EXPECT_THROW(make_adaptive_integrator<V2>(resolve_method("VV"), KeplerForce{}, with_tol(1e-8)), std::invalid_argument);
+  EXPECT_THROW(make_adaptive_integrator<V2>(resolve_method("VV"), KeplerForce{}, with_tol(1e-8)),
+               std::invalid_argument);
 
   auto ai = make_adaptive_integrator<V2>(def, KeplerForce{}, with_tol(1e-8));
   auto s = KeplerProblem<LD>(0.5L).initial_state();
@@ -216,8 +217,8 @@ TEST(AdaptiveRkn, StepControllerRatios) {
     EXPECT_DOUBLE_EQ(f, predictive ? 0.5 * 1.6 * 0.64 : 0.5 * 1.6);
     // The error fell: the trend factor would grow the step; the standard ratio is kept.
     EXPECT_DOUBLE_EQ(c.accepted(3.2, 0.8, false), 1.6);
-    EXPECT_DOUBLE_EQ(c.accepted(100.0, 1.0, false), 4.0);  // clamped to fac_max
-    EXPECT_DOUBLE_EQ(c.accepted(100.0, 1.0, true), 1.0);   // no growth right after a rejection
+    EXPECT_DOUBLE_EQ(c.accepted(100.0, 1.0, false), 4.0);     // clamped to fac_max
+    EXPECT_DOUBLE_EQ(c.accepted(100.0, 1.0, true), 1.0);      // no growth right after a rejection
     EXPECT_DOUBLE_EQ(c.accepted(INFINITY, 1.0, false), 4.0);  // err = 0
     EXPECT_DOUBLE_EQ(c.rejected(0.5), 0.25);
     EXPECT_DOUBLE_EQ(c.rejected(0.01), 0.2);  // clamped to fac_min

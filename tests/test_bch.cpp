@@ -94,7 +94,8 @@ void add(std::map<std::uint32_t, mpq_class>& acc, const Lp& x, const mpq_class& 
 TEST(LieAlgebra, FreeDimensionsFollowWittsFormula) {
   for (auto basis : {BasisKind::lyndon, BasisKind::hall}) {
     const auto& s = lie_structure(10, basis, AlgebraKind::free);
-    for (int d = 1; d <= 10; ++d) EXPECT_EQ(static_cast<long>(s.dimension(d)), witt(d)) << to_string(basis) << " degree " << d;
+    for (int d = 1; d <= 10; ++d)
+      EXPECT_EQ(static_cast<long>(s.dimension(d)), witt(d)) << to_string(basis) << " degree " << d;
   }
   EXPECT_EQ(witt(6), 9);
   EXPECT_THROW(lie_structure(0, BasisKind::hall, AlgebraKind::rkn), std::invalid_argument);
@@ -109,10 +110,10 @@ TEST(LieAlgebra, HallBasisHasTheGurkanNumbering) {
   EXPECT_EQ(s.elements()[0].bracket, "T");
   EXPECT_EQ(s.elements()[1].bracket, "V");
   // the defining brackets that the multiplication table names directly
-  const std::map<std::string, std::string> def{{"X3", "[X1,X2]"},  {"X4", "[X1,X3]"},  {"X5", "[X2,X3]"},  {"X6", "[X1,X4]"},
-                                               {"X7", "[X2,X4]"},  {"X9", "[X3,X4]"},  {"X10", "[X3,X5]"}, {"X11", "[X4,X5]"},
-                                               {"X12", "[X1,X6]"}, {"X13", "[X2,X6]"}, {"X16", "[X3,X6]"}, {"X17", "[X3,X7]"},
-                                               {"X19", "[X1,X12]"}, {"X20", "[X2,X12]"}};
+  const std::map<std::string, std::string> def{
+      {"X3", "[X1,X2]"},  {"X4", "[X1,X3]"},  {"X5", "[X2,X3]"},   {"X6", "[X1,X4]"},  {"X7", "[X2,X4]"},
+      {"X9", "[X3,X4]"},  {"X10", "[X3,X5]"}, {"X11", "[X4,X5]"},  {"X12", "[X1,X6]"}, {"X13", "[X2,X6]"},
+      {"X16", "[X3,X6]"}, {"X17", "[X3,X7]"}, {"X19", "[X1,X12]"}, {"X20", "[X2,X12]"}};
   for (const auto& [name, d] : def) {
     const int i = s.find(name);
     ASSERT_GE(i, 0) << name;
@@ -126,15 +127,33 @@ TEST(LieAlgebra, GurkanMultiplicationTableHoldsInTheRknQuotient) {
     int i, j;
     std::map<int, int> result;
   };
-  const std::vector<Row> table{
-      {1, 2, {{3, 1}}},   {1, 3, {{4, 1}}},           {1, 4, {{6, 1}}},   {1, 5, {{7, 1}}},  {1, 6, {{12, 1}}},
-      {1, 7, {{9, 1}, {13, 1}}}, {1, 9, {{16, 1}}},   {1, 10, {{11, 1}, {17, 1}}},          {1, 12, {{19, 1}}},
-      {1, 13, {{16, 1}, {20, 1}}}, {1, 14, {{11, -1}, {17, -1}}}, {2, 3, {{5, 1}}},         {2, 4, {{7, 1}}},
-      {2, 6, {{13, 1}}},  {2, 7, {{10, -1}}},         {2, 9, {{11, -1}, {17, 1}}},          {2, 12, {{20, 1}}},
-      {2, 13, {{17, -3}}}, {3, 4, {{9, 1}}},          {3, 5, {{10, 1}}},  {3, 6, {{16, 1}}}, {3, 7, {{17, 1}}},
-      {4, 5, {{11, 1}}}};
+  const std::vector<Row> table{{1, 2, {{3, 1}}},
+                               {1, 3, {{4, 1}}},
+                               {1, 4, {{6, 1}}},
+                               {1, 5, {{7, 1}}},
+                               {1, 6, {{12, 1}}},
+                               {1, 7, {{9, 1}, {13, 1}}},
+                               {1, 9, {{16, 1}}},
+                               {1, 10, {{11, 1}, {17, 1}}},
+                               {1, 12, {{19, 1}}},
+                               {1, 13, {{16, 1}, {20, 1}}},
+                               {1, 14, {{11, -1}, {17, -1}}},
+                               {2, 3, {{5, 1}}},
+                               {2, 4, {{7, 1}}},
+                               {2, 6, {{13, 1}}},
+                               {2, 7, {{10, -1}}},
+                               {2, 9, {{11, -1}, {17, 1}}},
+                               {2, 12, {{20, 1}}},
+                               {2, 13, {{17, -3}}},
+                               {3, 4, {{9, 1}}},
+                               {3, 5, {{10, 1}}},
+                               {3, 6, {{16, 1}}},
+                               {3, 7, {{17, 1}}},
+                               {4, 5, {{11, 1}}}};
   const auto& s = lie_structure(6, BasisKind::hall, AlgebraKind::rkn);
-  auto el = [&](int k) -> const LieElement& { return s.elements()[static_cast<std::size_t>(s.find("X" + std::to_string(k)))]; };
+  auto el = [&](int k) -> const LieElement& {
+    return s.elements()[static_cast<std::size_t>(s.find("X" + std::to_string(k)))];
+  };
   std::map<std::pair<int, int>, const Row*> listed;
   for (const auto& r : table) listed[{r.i, r.j}] = &r;
   int checked = 0;
@@ -214,8 +233,8 @@ TEST(Bch, TermsLinearInOneGeneratorAreBernoulliNumbers) {
   for (int n = 1; n < N; ++n) {
     const mpq_class plus = (n == 1 ? -b[1] : b[static_cast<std::size_t>(n)]) / factorial(n);
     const mpq_class minus = b[static_cast<std::size_t>(n)] / factorial(n);
-    EXPECT_EQ(z.at(n + 1, 1u), plus) << "T^" << n << " V";                              // T..TV = bits 0..01
-    EXPECT_EQ(z.at(n + 1, ((1u << n) - 1u) << 1), minus) << "V^" << n << " T";          // V..VT = bits 1..10
+    EXPECT_EQ(z.at(n + 1, 1u), plus) << "T^" << n << " V";                      // T..TV = bits 0..01
+    EXPECT_EQ(z.at(n + 1, ((1u << n) - 1u) << 1), minus) << "V^" << n << " T";  // V..VT = bits 1..10
   }
   EXPECT_EQ(z.at(7, 1u), mpq_class(1, 30240));  // B_6 / 6! (a nonzero check of the test's own recurrence)
 }
@@ -239,7 +258,8 @@ TEST(Bch, SeriesToDegreeSevenIsExactlyTheLogarithm) {
         for (std::uint32_t u = 0; u < (1u << la); ++u) {
           if (a[static_cast<std::size_t>(la)][u] == 0) continue;
           for (std::uint32_t v = 0; v < (1u << lb); ++v)
-            r[static_cast<std::size_t>(la + lb)][(u << lb) | v] += a[static_cast<std::size_t>(la)][u] * b[static_cast<std::size_t>(lb)][v];
+            r[static_cast<std::size_t>(la + lb)][(u << lb) | v] +=
+                a[static_cast<std::size_t>(la)][u] * b[static_cast<std::size_t>(lb)][v];
         }
     return r;
   };
@@ -252,7 +272,8 @@ TEST(Bch, SeriesToDegreeSevenIsExactlyTheLogarithm) {
   for (int k = 1; k <= N; ++k) {
     zk = times(zk, zw);
     for (int d = 0; d <= N; ++d)
-      for (std::size_t w = 0; w < zk[static_cast<std::size_t>(d)].size(); ++w) e[static_cast<std::size_t>(d)][w] += zk[static_cast<std::size_t>(d)][w] / factorial(k);
+      for (std::size_t w = 0; w < zk[static_cast<std::size_t>(d)].size(); ++w)
+        e[static_cast<std::size_t>(d)][w] += zk[static_cast<std::size_t>(d)][w] / factorial(k);
   }
   int nonzero = 0;
   for (int d = 0; d <= N; ++d)
@@ -355,8 +376,10 @@ TEST(Bch, SeriesToDegreeSevenMatchesMatrixLogarithm) {
 
 TEST(Bch, LieCoordinatesReproduceTheSeriesExactly) {
   // For the free algebra the coordinates in either basis, expanded back into words, give Z exactly.
-  const std::vector<std::pair<int, mpq_class>> product{{letter_T, mpq_class(1, 3)}, {letter_V, mpq_class(-2, 7)},
-                                                       {letter_T, mpq_class(5, 4)},  {letter_V, mpq_class(9, 5)},
+  const std::vector<std::pair<int, mpq_class>> product{{letter_T, mpq_class(1, 3)},
+                                                       {letter_V, mpq_class(-2, 7)},
+                                                       {letter_T, mpq_class(5, 4)},
+                                                       {letter_V, mpq_class(9, 5)},
                                                        {letter_T, mpq_class(-1, 2)}};
   for (auto basis : {BasisKind::hall, BasisKind::lyndon}) {
     const auto& s = lie_structure(7, basis, AlgebraKind::free);
@@ -364,7 +387,8 @@ TEST(Bch, LieCoordinatesReproduceTheSeriesExactly) {
       const auto z = log_of_product(f, 7);
       const auto c = LieProjector<mpq_class>(s)(z);
       for (int d = 1; d <= 7; ++d) {
-        EXPECT_EQ(s.expand(c[static_cast<std::size_t>(d)], d), words_of_degree(z, d)) << to_string(basis) << " degree " << d;
+        EXPECT_EQ(s.expand(c[static_cast<std::size_t>(d)], d), words_of_degree(z, d))
+            << to_string(basis) << " degree " << d;
       }
     }
   }
@@ -394,16 +418,15 @@ TEST(Bch, ReproducesGurkanTable43) {
     double norm;
     bool imaginary;
   };
-  const std::vector<Printed> table{
-      {"AR1", {-3.1e-3, 4.5e-4, 5.6e-3, 1.8e-5, -6.3e-5}, 6.44e-3, false},
-      {"AR2", {5.0e-3, -3.1e-4, -5.7e-3, 1.5e-5, 2.5e-4}, 7.58e-3, false},
-      {"BR1", {1.5e-4, 6.2e-5, -4.1e-4, 5.7e-5, 1.6e-4}, 4.71e-4, false},
-      {"BR2", {-7.0e-5, 9.7e-4, 2.7e-4, 5.2e-4, 5.2e-4}, 1.25e-3, false},
-      {"BR3", {3.5e-2, 1.9e-4, -3.5e-2, -3.0e-5, -1.0e-4}, 4.90e-2, false},
-      {"AC1", {-2.5e-6, 7.3e-6, -5.0e-6, 8.3e-7, 4.2e-6}, 1.02e-5, true},
-      {"AC2", {3.0e-6, -7.9e-6, 6.0e-6, -9.4e-7, -4.7e-6}, 1.15e-5, true},
-      {"BC1", {1.2e-5, -1.3e-5, 8.4e-6, 2.2e-7, -4.2e-6}, 1.96e-5, true},
-      {"BC2", {-4.1e-5, 4.9e-5, -1.2e-4, 7.7e-6, 5.0e-5}, 1.49e-4, true}};
+  const std::vector<Printed> table{{"AR1", {-3.1e-3, 4.5e-4, 5.6e-3, 1.8e-5, -6.3e-5}, 6.44e-3, false},
+                                   {"AR2", {5.0e-3, -3.1e-4, -5.7e-3, 1.5e-5, 2.5e-4}, 7.58e-3, false},
+                                   {"BR1", {1.5e-4, 6.2e-5, -4.1e-4, 5.7e-5, 1.6e-4}, 4.71e-4, false},
+                                   {"BR2", {-7.0e-5, 9.7e-4, 2.7e-4, 5.2e-4, 5.2e-4}, 1.25e-3, false},
+                                   {"BR3", {3.5e-2, 1.9e-4, -3.5e-2, -3.0e-5, -1.0e-4}, 4.90e-2, false},
+                                   {"AC1", {-2.5e-6, 7.3e-6, -5.0e-6, 8.3e-7, 4.2e-6}, 1.02e-5, true},
+                                   {"AC2", {3.0e-6, -7.9e-6, 6.0e-6, -9.4e-7, -4.7e-6}, 1.15e-5, true},
+                                   {"BC1", {1.2e-5, -1.3e-5, 8.4e-6, 2.2e-7, -4.2e-6}, 1.96e-5, true},
+                                   {"BC2", {-4.1e-5, 4.9e-5, -1.2e-4, 7.7e-6, 5.0e-5}, 1.49e-4, true}};
   auto rounds_to = [](double v, double printed, int digits) {
     // v rounded to `digits` significant digits equals the printed value
     if (printed == 0) return false;
@@ -435,7 +458,8 @@ TEST(Bch, ReproducesGurkanTable43) {
     EXPECT_TRUE(rounds_to(got.norm, want.norm, 3)) << want.name << " norm " << got.norm << " printed " << want.norm;
   }
   // the AC2 row as printed, from the adjoint
-  const auto adj = gurkan_table_4_3([](const std::string& n) { return resolve_method(n == "AC2" ? "adjoint:AC2" : n); });
+  const auto adj =
+      gurkan_table_4_3([](const std::string& n) { return resolve_method(n == "AC2" ? "adjoint:AC2" : n); });
   EXPECT_TRUE(rounds_to(adj[6].terms[0].second.imag(), 3.0e-6, 2));
   EXPECT_TRUE(rounds_to(adj[6].terms[1].second.imag(), -7.9e-6, 2));
 }

@@ -25,9 +25,8 @@ struct Out {
 };
 
 std::filesystem::path scratch() {
-  auto d = std::filesystem::temp_directory_path() /
-           ("nystrom-bchcli-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  auto d = std::filesystem::temp_directory_path() / ("nystrom-bchcli-" + std::to_string(::getpid()) + "-" +
+                                                     ::testing::UnitTest::GetInstance()->current_test_info()->name());
   std::filesystem::create_directories(d);
   return d;
 }
@@ -104,22 +103,22 @@ TEST(BchCli, GurkanTableHasEveryPrintedDigit) {
     double norm;
     bool imaginary;
   };
-  const std::vector<Printed> table{
-      {"AR1", {-3.1e-3, 4.5e-4, 5.6e-3, 1.8e-5, -6.3e-5}, 6.44e-3, false},
-      {"AR2", {5.0e-3, -3.1e-4, -5.7e-3, 1.5e-5, 2.5e-4}, 7.58e-3, false},
-      {"BR1", {1.5e-4, 6.2e-5, -4.1e-4, 5.7e-5, 1.6e-4}, 4.71e-4, false},
-      {"BR2", {-7.0e-5, 9.7e-4, 2.7e-4, 5.2e-4, 5.2e-4}, 1.25e-3, false},
-      {"BR3", {3.5e-2, 1.9e-4, -3.5e-2, -3.0e-5, -1.0e-4}, 4.90e-2, false},
-      {"AC1", {-2.5e-6, 7.3e-6, -5.0e-6, 8.3e-7, 4.2e-6}, 1.02e-5, true},
-      {"AC2", {3.0e-6, -7.9e-6, 6.0e-6, -9.4e-7, -4.7e-6}, 1.15e-5, true},
-      {"BC1", {1.2e-5, -1.3e-5, 8.4e-6, 2.2e-7, -4.2e-6}, 1.96e-5, true},
-      {"BC2", {-4.1e-5, 4.9e-5, -1.2e-4, 7.7e-6, 5.0e-5}, 1.49e-4, true}};
+  const std::vector<Printed> table{{"AR1", {-3.1e-3, 4.5e-4, 5.6e-3, 1.8e-5, -6.3e-5}, 6.44e-3, false},
+                                   {"AR2", {5.0e-3, -3.1e-4, -5.7e-3, 1.5e-5, 2.5e-4}, 7.58e-3, false},
+                                   {"BR1", {1.5e-4, 6.2e-5, -4.1e-4, 5.7e-5, 1.6e-4}, 4.71e-4, false},
+                                   {"BR2", {-7.0e-5, 9.7e-4, 2.7e-4, 5.2e-4, 5.2e-4}, 1.25e-3, false},
+                                   {"BR3", {3.5e-2, 1.9e-4, -3.5e-2, -3.0e-5, -1.0e-4}, 4.90e-2, false},
+                                   {"AC1", {-2.5e-6, 7.3e-6, -5.0e-6, 8.3e-7, 4.2e-6}, 1.02e-5, true},
+                                   {"AC2", {3.0e-6, -7.9e-6, 6.0e-6, -9.4e-7, -4.7e-6}, 1.15e-5, true},
+                                   {"BC1", {1.2e-5, -1.3e-5, 8.4e-6, 2.2e-7, -4.2e-6}, 1.96e-5, true},
+                                   {"BC2", {-4.1e-5, 4.9e-5, -1.2e-4, 7.7e-6, 5.0e-5}, 1.49e-4, true}};
   // The table shows 3 significant digits for the terms and 4 for the norm, themselves rounded, so "agrees with the
   // paper's `digits` digits" means: within half a unit of the paper's last digit plus half a unit of the shown last
   // digit (the exact rounding of the full values is asserted in test_bch, ReproducesGurkanTable43).
   auto agrees = [](double shown, int shown_digits, double printed, int digits) {
     const auto unit = [](double x, int d) { return std::pow(10.0, std::floor(std::log10(std::abs(x))) - (d - 1)); };
-    return std::abs(shown - printed) <= 0.5 * unit(printed, digits) + 0.5 * unit(shown, shown_digits) + 1e-12 * std::abs(printed);
+    return std::abs(shown - printed) <=
+           0.5 * unit(printed, digits) + 0.5 * unit(shown, shown_digits) + 1e-12 * std::abs(printed);
   };
   const auto r = nystrom("bch --gurkan-table");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -140,15 +139,18 @@ TEST(BchCli, GurkanTableHasEveryPrintedDigit) {
       const std::string& t = got[k];
       EXPECT_EQ(t.back() == 'i', want.imaginary) << want.name << " X" << k << ": " << t;
       const double v = std::stod(want.imaginary ? t.substr(0, t.size() - 1) : t);
-      EXPECT_TRUE(agrees(sign * v, 3, want.x[k], 2)) << want.name << " term " << k << ": " << t << " vs printed " << want.x[k];
+      EXPECT_TRUE(agrees(sign * v, 3, want.x[k], 2))
+          << want.name << " term " << k << ": " << t << " vs printed " << want.x[k];
     }
-    EXPECT_TRUE(agrees(std::stod(got[5]), 4, want.norm, 3)) << want.name << " norm " << got[5] << " vs printed " << want.norm;
+    EXPECT_TRUE(agrees(std::stod(got[5]), 4, want.norm, 3))
+        << want.name << " norm " << got[5] << " vs printed " << want.norm;
   }
 }
 
 TEST(BchCli, DiscoverWritesMethodsThatRun) {
   const auto dir = scratch() / "found";
-  const auto r = nystrom("discover --scheme A --starts 120 --seed 2 --threads 2 --show imaginary --write " + dir.string() + " --json");
+  const auto r = nystrom("discover --scheme A --starts 120 --seed 2 --threads 2 --show imaginary --write " +
+                         dir.string() + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.size(), 1u);
@@ -190,15 +192,19 @@ TEST(BchCli, BadInputIsOneLineAndExitCode2) {
   const auto noname = scratch() / "noname.txt";
   std::ofstream(noname) << "order 2\ndrift 1/2\nkick 1\ndrift 1/2\n";
   const auto garbage = scratch() / "garbage.txt";
-  std::ofstream(garbage) << std::string("\x7f" "ELF\x01\x02\x03\x00\xff\xfe kick", 15) << "\n";
+  std::ofstream(garbage) << std::string(
+                                "\x7f"
+                                "ELF\x01\x02\x03\x00\xff\xfe kick",
+                                15)
+                         << "\n";
   for (const std::string& args :
-       {std::string("bch --method NoSuchMethod"), std::string("bch --method N4"), std::string("bch --method VV --degree 0"),
-        std::string("bch --method VV --basis hal"), std::string("bch"), std::string("discover --starts 0"),
-        std::string("discover --scheme C"), std::string("discover --solver bfgs"), std::string("discover --show some"),
-        std::string("discover --six-stage --from VV"), "run --method file:" + bad.string(),
-        "run --method file:" + nan.string(), "run --method file:" + noname.string(),
-        "run --method file:" + garbage.string(), "bch --method file:" + bad.string(),
-        "run --method file:" + scratch().string(),
+       {std::string("bch --method NoSuchMethod"), std::string("bch --method N4"),
+        std::string("bch --method VV --degree 0"), std::string("bch --method VV --basis hal"), std::string("bch"),
+        std::string("discover --starts 0"), std::string("discover --scheme C"), std::string("discover --solver bfgs"),
+        std::string("discover --show some"), std::string("discover --six-stage --from VV"),
+        "run --method file:" + bad.string(), "run --method file:" + nan.string(),
+        "run --method file:" + noname.string(), "run --method file:" + garbage.string(),
+        "bch --method file:" + bad.string(), "run --method file:" + scratch().string(),
         std::string("run --method file:/nonexistent/x.txt")}) {
     const auto r = nystrom(args);
     EXPECT_EQ(r.code, 2) << args << "\n" << r.out << r.err;

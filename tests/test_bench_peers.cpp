@@ -83,10 +83,12 @@ class BenchPeers : public ::testing::Test {
   static inline json* j_ = nullptr;
 };
 
-const std::vector<std::string> kNystromFixed{"VV", "M4", "M6", "M6-5F", "A6", "M8", "KL8", "M10", "SS10", "M12", "DP12"};
-const std::vector<std::string> kOdeintFixed{"odeint velocity_verlet", "odeint sb3a_mclachlan", "odeint sb3a_m4_mclachlan",
-                                            "odeint rkf78"};
-const std::vector<std::string> kAdaptive{"DP12-adaptive", "M10-adaptive", "M12-adaptive", "M14-adaptive", "M16-adaptive", "M12-adaptive (no comp.)",
+const std::vector<std::string> kNystromFixed{"VV",  "M4",  "M6",   "M6-5F", "A6",  "M8",
+                                             "KL8", "M10", "SS10", "M12",   "DP12"};
+const std::vector<std::string> kOdeintFixed{"odeint velocity_verlet", "odeint sb3a_mclachlan",
+                                            "odeint sb3a_m4_mclachlan", "odeint rkf78"};
+const std::vector<std::string> kAdaptive{"DP12-adaptive", "M10-adaptive",  "M12-adaptive",
+                                         "M14-adaptive",  "M16-adaptive",  "M12-adaptive (no comp.)",
                                          "GBS",           "odeint dopri5", "odeint bulirsch_stoer"};
 
 }  // namespace
@@ -225,7 +227,8 @@ TEST_F(BenchPeers, TargetsAreTheFastestRunsBelowTheTarget) {
       }
     }
     if (!t["nystrom"].is_null() && !t["odeint"].is_null()) {
-      EXPECT_DOUBLE_EQ(t["ratio"].get<double>(), t["odeint"]["seconds"].get<double>() / t["nystrom"]["seconds"].get<double>());
+      EXPECT_DOUBLE_EQ(t["ratio"].get<double>(),
+                       t["odeint"]["seconds"].get<double>() / t["nystrom"]["seconds"].get<double>());
     } else {
       EXPECT_TRUE(t["ratio"].is_null());
     }
@@ -268,7 +271,8 @@ TEST_F(BenchPeers, InterleavedRetimingRebuildsTheSameRuns) {
       EXPECT_EQ(p["nystrom_error"].get<double>(), t["nystrom"]["error"].get<double>());
       EXPECT_LE(p["odeint_error"].get<double>(), 10 * t["target"].get<double>());
       EXPECT_GT(p["nystrom_seconds"].get<double>(), 0);
-      EXPECT_DOUBLE_EQ(p["ratio"].get<double>(), p["odeint_seconds"].get<double>() / p["nystrom_seconds"].get<double>());
+      EXPECT_DOUBLE_EQ(p["ratio"].get<double>(),
+                       p["odeint_seconds"].get<double>() / p["nystrom_seconds"].get<double>());
     }
   EXPECT_EQ(il.size(), both);
   EXPECT_GE(both, 3u);

@@ -24,7 +24,8 @@ using V2 = std::array<LD, 2>;
 
 // The splitting methods of three publication headers: compositions (PV defaults, VV variants),
 // Blanes-Moan, Gürkan (with Chambers).
-const std::vector<std::string> kCompositions = {"Y4", "Y6", "KL6", "KL8", "SS10", "Y4-V", "Y6-V", "KL6-V", "KL8-V", "SS10-V"};
+const std::vector<std::string> kCompositions = {"Y4",   "Y6",   "KL6",   "KL8",   "SS10",
+                                                "Y4-V", "Y6-V", "KL6-V", "KL8-V", "SS10-V"};
 const std::vector<std::string> kBlanesMoan = {"RKNb6", "RKNa14"};
 const std::vector<std::string> kGurkanReal = {"AR1", "AR2", "BR1", "BR2", "BR3"};
 const std::vector<std::string> kGurkanComplex = {"AC1", "AC2", "BC1", "BC2", "AC1-6"};
@@ -145,7 +146,8 @@ const V2& henon_heiles_reference() {
 double henon_heiles_order(const MethodDef& def, const std::vector<long>& ns) {
   std::vector<double> errs;
   for (long n : ns)
-    errs.push_back(dist(run_ld(def, HenonHeilesForce{}, kHenonHeilesStart, kHenonHeilesTime, n).q, henon_heiles_reference()));
+    errs.push_back(
+        dist(run_ld(def, HenonHeilesForce{}, kHenonHeilesStart, kHenonHeilesTime, n).q, henon_heiles_reference()));
   return fit_order(ns, errs);
 }
 
@@ -199,7 +201,8 @@ bigfloat max_abs(const Mat& m) {
 }
 /// exp(s X) by its Taylor series (s |X| is small here), to the working precision.
 Mat expm(const Mat& X, const bigfloat& s) {
-  const bigfloat tiny = boost::multiprecision::ldexp(bigfloat(1), -static_cast<int>(bigfloat::default_precision() * 3.33) - 8);
+  const bigfloat tiny =
+      boost::multiprecision::ldexp(bigfloat(1), -static_cast<int>(bigfloat::default_precision() * 3.33) - 8);
   Mat result = identity(), term = identity();
   for (int k = 1; k < 400; ++k) {
     term = mat_mul(term, X);
@@ -270,10 +273,10 @@ TEST(CatalogSplitting, PublicationSplittingMethodsAreRegisteredWithTheirSources)
   }
   // Gürkan's figure labels and the published names resolve to the same entries.
   const std::vector<std::pair<std::string, std::string>> aliases = {
-      {"RKNar1", "AR1"},     {"RKNar2", "AR2"},       {"RKNbr1", "BR1"},   {"RKNbr2", "BR2"},
-      {"RKNbr3", "BR3"},     {"RKNac1", "AC1"},       {"RKNac2", "AC2"},   {"RKNbc1", "BC1"},
-      {"RKNbc2", "BC2"},     {"SRKN6b", "RKNb6"},     {"SRKN14a", "RKNa14"}, {"s9odr6a", "KL6"},
-      {"s17odr8a", "KL8"},   {"SofSpa10", "SS10"},    {"yoshida6", "Y6"},  {"rknac1-6", "AC1-6"}};
+      {"RKNar1", "AR1"},   {"RKNar2", "AR2"},    {"RKNbr1", "BR1"},     {"RKNbr2", "BR2"},
+      {"RKNbr3", "BR3"},   {"RKNac1", "AC1"},    {"RKNac2", "AC2"},     {"RKNbc1", "BC1"},
+      {"RKNbc2", "BC2"},   {"SRKN6b", "RKNb6"},  {"SRKN14a", "RKNa14"}, {"s9odr6a", "KL6"},
+      {"s17odr8a", "KL8"}, {"SofSpa10", "SS10"}, {"yoshida6", "Y6"},    {"rknac1-6", "AC1-6"}};
   for (const auto& [alias, name] : aliases) EXPECT_EQ(resolve_method(alias).info.name, name) << alias;
   // The complex ones are recognised as complex, the others not.
   for (const auto& n : kGurkanComplex) EXPECT_TRUE(resolve_method(n).info.complex) << n;
@@ -317,7 +320,8 @@ TEST(CatalogSplitting, SymmetricFlagMatchesPalindromes) {
     const auto r = adjoint(s);
     bool palindrome = true;
     for (std::size_t i = 0; i < s.steps.size(); ++i)
-      palindrome = palindrome && s.steps[i].flow == r.steps[i].flow && cabs(s.steps[i].coef - r.steps[i].coef) < bigfloat("1e-70");
+      palindrome = palindrome && s.steps[i].flow == r.steps[i].flow &&
+                   cabs(s.steps[i].coef - r.steps[i].coef) < bigfloat("1e-70");
     EXPECT_EQ(palindrome, d.info.symmetric) << d.info.name;
   }
 }
@@ -442,7 +446,8 @@ TEST(Compositions, OrderConditionsOnGenericMatrices) {
     SplittingScheme<bigcomplex> scheme;
   };
   std::vector<Case> cases;
-  for (const auto& n : kCompositions) cases.push_back({n, resolve_method(n).info.order, scheme_of(resolve_method(n), 256)});
+  for (const auto& n : kCompositions)
+    cases.push_back({n, resolve_method(n).info.order, scheme_of(resolve_method(n), 256)});
   for (const auto& spec : {"triplejump:6", "triplejump:8", "triplejump-vv:8", "triplejump:10", "suzuki:4", "suzuki:6",
                            "suzuki-vv:6", "suzuki:8"})
     cases.push_back({spec, resolve_method(spec).info.order, scheme_of(resolve_method(spec), 256)});
@@ -475,13 +480,22 @@ TEST(ObservedOrder, KeplerCompositionsAndBlanesMoan) {
   // Kepler e = 0.5, 1.37 periods, long double. Step counts chosen in the asymptotic range and above
   // the round-off floor (~1e-17): for SS10 that window is narrow (errors 1e-14 ... 1e-15). RKNb6 is
   // an optimized fourth-order method whose h^6 term dominates down to ~1e-11 (n ~ 700).
-  const std::vector<std::pair<std::string, std::vector<long>>> cases = {
-      {"Y4", {512, 724, 1024}},       {"Y4-V", {512, 724, 1024}},   {"Y6", {256, 362, 512}},
-      {"Y6-V", {256, 362, 512}},      {"KL6", {256, 362, 512}},     {"KL6-V", {256, 362, 512}},
-      {"KL8", {128, 181, 256}},       {"KL8-V", {128, 181, 256}},   {"SS10", {100, 112, 126}},
-      {"SS10-V", {100, 126, 158}},    {"RKNb6", {1024, 1448, 2048}}, {"RKNa14", {128, 181, 256}},
-      {"triplejump:6", {724, 1024, 1448}}, {"triplejump-vv:6", {724, 1024, 1448}}, {"suzuki:4", {256, 362, 512}},
-      {"suzuki:6", {181, 256, 362}}};
+  const std::vector<std::pair<std::string, std::vector<long>>> cases = {{"Y4", {512, 724, 1024}},
+                                                                        {"Y4-V", {512, 724, 1024}},
+                                                                        {"Y6", {256, 362, 512}},
+                                                                        {"Y6-V", {256, 362, 512}},
+                                                                        {"KL6", {256, 362, 512}},
+                                                                        {"KL6-V", {256, 362, 512}},
+                                                                        {"KL8", {128, 181, 256}},
+                                                                        {"KL8-V", {128, 181, 256}},
+                                                                        {"SS10", {100, 112, 126}},
+                                                                        {"SS10-V", {100, 126, 158}},
+                                                                        {"RKNb6", {1024, 1448, 2048}},
+                                                                        {"RKNa14", {128, 181, 256}},
+                                                                        {"triplejump:6", {724, 1024, 1448}},
+                                                                        {"triplejump-vv:6", {724, 1024, 1448}},
+                                                                        {"suzuki:4", {256, 362, 512}},
+                                                                        {"suzuki:6", {181, 256, 362}}};
   for (const auto& [name, ns] : cases) {
     const MethodDef d = resolve_method(name);
     const double p = kepler_order(d, 0.5, ns);
@@ -527,7 +541,8 @@ TEST(ObservedOrder, ComplexMethodsWithImaginaryPartsDropped) {
   EXPECT_LE(ac1, 6.6);
   EXPECT_GE(chambers, 3.6);
   EXPECT_LE(chambers, 4.6);
-  for (const auto& name : {"AC2", "BC1", "BC2", "AC1-6"}) EXPECT_NEAR(kepler_order(resolve_method(name), 0.2, ns), 6.0, 0.4) << name;
+  for (const auto& name : {"AC2", "BC1", "BC2", "AC1-6"})
+    EXPECT_NEAR(kepler_order(resolve_method(name), 0.2, ns), 6.0, 0.4) << name;
   // The same on Hénon-Heiles: the effect is not special to Kepler.
   EXPECT_NEAR(henon_heiles_order(resolve_method("AC1"), {40, 80, 160}), 6.0, 0.3);
   EXPECT_NEAR(henon_heiles_order(resolve_method("Chambers"), {160, 320, 640}), 4.0, 0.3);
@@ -561,12 +576,32 @@ TEST(ObservedOrder, ComplexMethodsKeepingTheImaginaryPart) {
 
 TEST(CatalogSplitting, ForcesPerStep) {
   const std::vector<std::pair<std::string, int>> expected = {
-      {"Y4", 3},     {"Y6", 7},     {"Y6-V", 7},    {"KL6", 9},   {"KL6-V", 9}, {"KL8", 17},  {"KL8-V", 17},
-      {"SS10", 35},  {"SS10-V", 35}, {"RKNb6", 6},  {"RKNa14", 14}, {"AR1", 5}, {"AR2", 5},   {"BR1", 5},
-      {"BR2", 5},    {"BR3", 5},    {"AC1", 5},     {"AC2", 5},   {"Chambers", 2},
+      {"Y4", 3},
+      {"Y6", 7},
+      {"Y6-V", 7},
+      {"KL6", 9},
+      {"KL6-V", 9},
+      {"KL8", 17},
+      {"KL8-V", 17},
+      {"SS10", 35},
+      {"SS10-V", 35},
+      {"RKNb6", 6},
+      {"RKNa14", 14},
+      {"AR1", 5},
+      {"AR2", 5},
+      {"BR1", 5},
+      {"BR2", 5},
+      {"BR3", 5},
+      {"AC1", 5},
+      {"AC2", 5},
+      {"Chambers", 2},
       // Kick-first complex methods: the last force is taken at a complex position and the state is
       // projected to real after the step, so it cannot be reused (no FSAL): 5 + 1 and 6 + 1.
-      {"BC1", 6},    {"BC2", 6},    {"AC1-6", 7},   {"triplejump:8", 27}, {"suzuki:6", 25}};
+      {"BC1", 6},
+      {"BC2", 6},
+      {"AC1-6", 7},
+      {"triplejump:8", 27},
+      {"suzuki:6", 25}};
   for (const auto& [name, f] : expected) {
     const MethodDef d = resolve_method(name);
     EXPECT_EQ(d.info.forces_per_step, f) << name;
@@ -640,8 +675,8 @@ TEST(CatalogSplitting, ParametricCompositions) {
   EXPECT_EQ(resolve_method("suzuki:6").info.stages, 25);
   EXPECT_EQ(resolve_method("suzuki-vv:4").info.forces_per_step, 5);
   EXPECT_EQ(resolve_method("triplejump:2").info.stages, 1);  // order 2: the leapfrog itself
-  for (const auto& bad : {"triplejump:5", "triplejump:0", "triplejump:-4", "triplejump:", "triplejump:x", "triplejump:6a",
-                          "triplejump:22", "suzuki:16", "suzuki:3", "suzuki-xx:4", "triplejump:99999"})
+  for (const auto& bad : {"triplejump:5", "triplejump:0", "triplejump:-4", "triplejump:", "triplejump:x",
+                          "triplejump:6a", "triplejump:22", "suzuki:16", "suzuki:3", "suzuki-xx:4", "triplejump:99999"})
     EXPECT_THROW(resolve_method(bad), std::invalid_argument) << bad;
   EXPECT_THROW(methods::triple_jump_weights(7), std::invalid_argument);
   EXPECT_THROW(methods::suzuki_weights(0), std::invalid_argument);

@@ -34,8 +34,8 @@ std::string slurp(const std::filesystem::path& p) {
 }
 
 std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() /
-           ("nystrom-cli-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  auto d = std::filesystem::temp_directory_path() / ("nystrom-cli-" + std::to_string(::getpid()) + "-" +
+                                                     ::testing::UnitTest::GetInstance()->current_test_info()->name());
   std::filesystem::create_directories(d);
   return d;
 }
@@ -88,8 +88,8 @@ TEST(Cli, RunJsonHasTheContractFields) {
   const auto r = run("run --problem kepler --ecc 0.9 --method M8 --steps-per-period 1000 --periods 10 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  for (const char* key :
-       {"method", "order", "steps", "force_evals", "precession_per_period", "energy_error", "position_error", "seconds"})
+  for (const char* key : {"method", "order", "steps", "force_evals", "precession_per_period", "energy_error",
+                          "position_error", "seconds"})
     ASSERT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["method"], "M8");
   EXPECT_EQ(j["order"], 8);

@@ -37,9 +37,8 @@ std::string slurp(const std::filesystem::path& p) {
 }
 
 std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() /
-           ("nystrom-cli-solve-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  auto d = std::filesystem::temp_directory_path() / ("nystrom-cli-solve-" + std::to_string(::getpid()) + "-" +
+                                                     ::testing::UnitTest::GetInstance()->current_test_info()->name());
   std::filesystem::create_directories(d);
   return d;
 }
@@ -61,8 +60,9 @@ constexpr double pi = std::numbers::pi;
 }  // namespace
 
 TEST(CliSolve, OutputTimesComeFromTheDenseOutput) {
-  const auto r = run(
-      "run --problem kepler --ecc 0.5 --method M8 --steps-per-period 200 --periods 2 --output-times 0:12.566:201 --json");
+  const auto r =
+      run("run --problem kepler --ecc 0.5 --method M8 --steps-per-period 200 --periods 2 --output-times 0:12.566:201 "
+          "--json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const auto& out = j.at("output");
@@ -82,8 +82,9 @@ TEST(CliSolve, OutputTimesComeFromTheDenseOutput) {
 }
 
 TEST(CliSolve, PericentreApocentreAndAxisCrossingEvents) {
-  const auto r = run("run --problem kepler --ecc 0.9 --method DP12-adaptive --tol 1e-12 --periods 3 --events "
-                     "pericentre,apocentre,y=0 --json");
+  const auto r =
+      run("run --problem kepler --ecc 0.9 --method DP12-adaptive --tol 1e-12 --periods 3 --events "
+          "pericentre,apocentre,y=0 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   std::vector<double> peri, apo, axis;
@@ -103,8 +104,9 @@ TEST(CliSolve, PericentreApocentreAndAxisCrossingEvents) {
   // The x axis is crossed at every pericentre and apocentre.
   EXPECT_GE(axis.size(), 5u);
   EXPECT_LE(axis.size(), 6u);
-  const auto only = run("run --problem kepler --ecc 0.9 --method DP12-adaptive --tol 1e-12 --periods 3 --events "
-                        "pericentre --json");
+  const auto only =
+      run("run --problem kepler --ecc 0.9 --method DP12-adaptive --tol 1e-12 --periods 3 --events "
+          "pericentre --json");
   ASSERT_EQ(only.code, 0) << only.err;
   EXPECT_EQ(nlohmann::json::parse(only.out).at("events").size(), 3u);
 }
@@ -133,10 +135,12 @@ TEST(CliSolve, RestartFromACheckpointEndsInBitwiseTheSameState) {
     EXPECT_EQ(other.code, 2);
     EXPECT_NE(other.err.find("nystrom: error: "), std::string::npos) << other.err;
   }
-  const auto missing = run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --restart " + (dir / "none").string());
+  const auto missing =
+      run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --restart " + (dir / "none").string());
   EXPECT_EQ(missing.code, 2);
   std::ofstream(dir / "bad.ckpt") << "not a checkpoint\n";
-  const auto bad = run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --restart " + (dir / "bad.ckpt").string());
+  const auto bad =
+      run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --restart " + (dir / "bad.ckpt").string());
   EXPECT_EQ(bad.code, 2);
   const auto half = run("run --problem kepler --ecc 0.5 --method M8 --periods 2 --checkpoint-at 3");
   EXPECT_EQ(half.code, 2);

@@ -114,8 +114,8 @@ TEST(Compensated, MpeM8) {
 TEST(Compensated, RknM65F) {
   const Outcome off = roundoff_error("M6-5F", 200, 1000, Compensation::off);
   const Outcome on = roundoff_error("M6-5F", 200, 1000, Compensation::automatic);
-  std::cout << "M6-5F at 200 steps/period, 1000 periods: round-off error uncompensated " << off.err
-            << ", compensated " << on.err << "\n";
+  std::cout << "M6-5F at 200 steps/period, 1000 periods: round-off error uncompensated " << off.err << ", compensated "
+            << on.err << "\n";
   EXPECT_LT(on.err, off.err);
 }
 

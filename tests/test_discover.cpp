@@ -39,8 +39,10 @@ double max_residual(RknForm form, const std::vector<cd>& sub) {
 }  // namespace
 
 TEST(Discover, ConditionsVanishOnThePublishedMethods) {
-  for (const char* n : {"AR1", "AR2", "AC1", "AC2"}) EXPECT_LT(max_residual(RknForm::A, coefficients_of(n)), 1e-15) << n;
-  for (const char* n : {"BR1", "BR2", "BR3", "BC1", "BC2"}) EXPECT_LT(max_residual(RknForm::B, coefficients_of(n)), 1e-15) << n;
+  for (const char* n : {"AR1", "AR2", "AC1", "AC2"})
+    EXPECT_LT(max_residual(RknForm::A, coefficients_of(n)), 1e-15) << n;
+  for (const char* n : {"BR1", "BR2", "BR3", "BC1", "BC2"})
+    EXPECT_LT(max_residual(RknForm::B, coefficients_of(n)), 1e-15) << n;
   // controls: a perturbed coefficient, and the other scheme's reading of the same numbers
   auto ar1 = coefficients_of("AR1");
   ar1[3] += 1e-6;
@@ -125,7 +127,8 @@ TEST(Discover, SmallSeededSearchFindsAR1AndAC1) {
   // duplicates, adjoints (reversal) and conjugates are merged: no two listed methods are the same
   for (std::size_t i = 0; i < rep.methods.size(); ++i)
     for (std::size_t j = i + 1; j < rep.methods.size(); ++j)
-      EXPECT_FALSE(same_up_to_symmetry(rep.methods[i].coefficients_d, rep.methods[j].coefficients_d, 1e-8)) << i << " " << j;
+      EXPECT_FALSE(same_up_to_symmetry(rep.methods[i].coefficients_d, rep.methods[j].coefficients_d, 1e-8))
+          << i << " " << j;
   long hits = 0;
   for (const auto& m : rep.methods) hits += m.hits;
   EXPECT_LE(hits, rep.converged);
@@ -193,7 +196,7 @@ TEST(Discover, SixStageSearchFromAC1ReachesThePublishedLevel) {
   EXPECT_NEAR(res.minima.front().start_error_norm, 1.02e-5, 0.005e-5);  // AC1, Table 4.3
   EXPECT_LT(res.minima.front().error_norm, 2.6e-7);
   EXPECT_LT(res.minima.front().constraint_residual, 1e-40);  // polished: the order conditions to 160 bits
-  EXPECT_GE(res.minima.size(), 2u);  // the landscape has several local minima
+  EXPECT_GE(res.minima.size(), 2u);                          // the landscape has several local minima
   // The best minimum lies in the basin of the published method (measured: 1.6e-2 apart in the coefficients) with a
   // norm of the published size or below (measured 3.6e-8: the printed method is not the bottom of its basin, see
   // PublishedSixStageMethodIsNotStationaryAndImproves); far below would mean a broken objective.

@@ -44,8 +44,8 @@ TEST(DormandPrince1987, TwelfthOrderWeightsHaveOrderExactlyTwelve) {
 
 TEST(DormandPrince1987, TenthOrderWeightsHaveOrderExactlyTen) {
   BigPrecision guard(256);
-  for (const auto& t : {real_tableau(methods::dprkn10_tableau()),
-                        real_tableau(embedded_tableau(methods::dprkn12_10_tableau()))}) {
+  for (const auto& t :
+       {real_tableau(methods::dprkn10_tableau()), real_tableau(embedded_tableau(methods::dprkn12_10_tableau()))}) {
     RknOrderConditions<bigfloat> oc(t);
     EXPECT_LE(oc.max_residual(10), bigfloat("1e-50"));
     EXPECT_GT(oc.max_residual_of_order(11), bigfloat("1e-8"));

@@ -72,7 +72,7 @@ TEST(MpeCoefficients, OptimalSequenceMaximisesTheProduct) {
       ASSERT_EQ(sum, K);
       const auto best = mpe_coefficients(k).error;
       std::function<void(int, long, long, std::vector<long>&)> rec = [&](int left, long minv, long rest,
-                                                                          std::vector<long>& cur) {
+                                                                         std::vector<long>& cur) {
         if (left == 0) {
           if (rest == 0) {
             EXPECT_LE(abs(best), abs(mpe_coefficients(cur).error)) << "n=" << n << " K=" << K;

@@ -140,7 +140,7 @@ TEST(NBodyRun, MethodsAndGbsOnBothProblems) {
   const auto a = run_nbody("VV", nb, 0.01, 10);
   EXPECT_GT(a.position_error, 0);
   EXPECT_LT(a.energy_error, 1e-3);
-  EXPECT_THROW(run_nbody("GBS", nb, 0.01, 10), std::invalid_argument);     // no tolerance
+  EXPECT_THROW(run_nbody("GBS", nb, 0.01, 10), std::invalid_argument);       // no tolerance
   EXPECT_THROW(run_nbody("VV", nb, 0.01, 10, 1e-9), std::invalid_argument);  // tolerance for a fixed-step method
   EXPECT_THROW(run_nbody("VV", nb, -0.01, 10), std::invalid_argument);
 }

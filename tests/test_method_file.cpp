@@ -45,7 +45,8 @@ const std::string kVerlet = "name pv\norder 2\ndrift 1/2\nkick 1\ndrift 1/2\n";
 
 TEST(MethodFile, RoundTripOfAClosedFormMethod) {
   BigPrecision guard(256);
-  const auto path = write("fr.txt", format_method_file("FR-file", 4, "Forest & Ruth (1990)", "test copy of FR", scheme_of("FR"), 40));
+  const auto path =
+      write("fr.txt", format_method_file("FR-file", 4, "Forest & Ruth (1990)", "test copy of FR", scheme_of("FR"), 40));
   const auto f = read_method_file(path);
   EXPECT_EQ(f.name, "FR-file");
   EXPECT_EQ(f.order, 4);

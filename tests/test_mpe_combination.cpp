@@ -50,10 +50,9 @@ Row measure(const std::string& spec, long steps_per_period, long periods) {
   diff.compensated = Compensation::off;
   const Row r{roundoff(spec, steps_per_period, periods, naive), roundoff(spec, steps_per_period, periods, diff),
               roundoff(spec, steps_per_period, periods, EngineOptions{})};
-  std::cout << spec << " (" << steps_per_period << " steps/period, " << periods
-            << " periods) round-off |dq|: naive " << r.naive << ", difference " << r.difference << ", compensated "
-            << r.compensated << "  (naive/difference " << r.naive / r.difference << ", naive/compensated "
-            << r.naive / r.compensated << ")\n";
+  std::cout << spec << " (" << steps_per_period << " steps/period, " << periods << " periods) round-off |dq|: naive "
+            << r.naive << ", difference " << r.difference << ", compensated " << r.compensated << "  (naive/difference "
+            << r.naive / r.difference << ", naive/compensated " << r.naive / r.compensated << ")\n";
   return r;
 }
 

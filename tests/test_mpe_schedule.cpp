@@ -60,7 +60,8 @@ void expect_identical(const Result<V>& a, const Result<V>& b, const std::string&
   EXPECT_EQ(a.evals, b.evals) << what << ": force counts differ";
 }
 
-const std::vector<std::string> kSpecs{"M4", "M6", "M8", "M12", "M16", "mpe-vv:1,2,3,4", "mpe:2,3,5", "mpe:1,3,4,7,9,10"};
+const std::vector<std::string> kSpecs{
+    "M4", "M6", "M8", "M12", "M16", "mpe-vv:1,2,3,4", "mpe:2,3,5", "mpe:1,3,4,7,9,10"};
 
 TEST(MpeSchedule, KeplerFixedSizeAllSchedulesBitwiseIdentical) {
   using V = std::array<double, 2>;
@@ -93,8 +94,8 @@ TEST(MpeSchedule, DynamicStatesAndExtendedPrecision) {
   const State<VD> d0{VD(s0.q.begin(), s0.q.end()), VD(s0.v.begin(), s0.v.end())};
   const double h = KeplerProblem<double>::period() / 61.0;
   for (const std::string spec : {"M8", "mpe-vv:1,2,3"}) {
-    const auto fixed = run<std::array<double, 2>>(spec, KeplerForce{}, s0, h, 200, MpeSchedule::sequential,
-                                                  Compensation::on);
+    const auto fixed =
+        run<std::array<double, 2>>(spec, KeplerForce{}, s0, h, 200, MpeSchedule::sequential, Compensation::on);
     for (auto sch : {MpeSchedule::sequential, MpeSchedule::lockstep, MpeSchedule::concurrent}) {
       const auto dyn = run<VD>(spec, KeplerVectorForce{}, d0, h, 200, sch, Compensation::on, 2);
       for (std::size_t j = 0; j < 2; ++j) {

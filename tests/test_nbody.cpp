@@ -104,8 +104,8 @@ TEST(NBodyForce, ComplexInversePowerIsThePrincipalBranch) {
 // not depend on the other lanes of its vector (a vector with one lane of Re z < 0 takes the other path).
 TEST(NBodyForce, SimdComplexInversePowerAgreesWithTheScalarReference) {
   if (!nbody_simd_available()) GTEST_SKIP() << "no AVX-512 on this CPU";
-  std::vector<std::pair<double, double>> z = {{3.0, 0.5},   {3.0, -0.5},  {-0.7, 2.0},  {-0.7, -2.0}, {-4.0, 0.0},
-                                              {-4.0, -0.0}, {4.0, 0.0},   {1e-3, 1e-3}, {0.0, 2.0},  {0.0, -2.0},
+  std::vector<std::pair<double, double>> z = {{3.0, 0.5},   {3.0, -0.5},     {-0.7, 2.0},  {-0.7, -2.0},  {-4.0, 0.0},
+                                              {-4.0, -0.0}, {4.0, 0.0},      {1e-3, 1e-3}, {0.0, 2.0},    {0.0, -2.0},
                                               {1e60, 3e59}, {-2e-50, 1e-50}, {5e-3, -7e2}, {-1.0, 1e-30}, {2.5, 1e-12}};
   std::mt19937_64 g(17);
   for (int k = 0; k < 200; ++k) {
@@ -213,7 +213,8 @@ TEST(NBodyForce, SimdComplexKernelAgreesFarFromTheRealAxis) {
   for (std::size_t i = 0; i < 300; ++i)
     for (std::size_t j = 0; j < 300; ++j) {
       C r2 = 0;
-      for (std::size_t c = 0; c < 3; ++c) r2 += (qc[c * 300 + j] - qc[c * 300 + i]) * (qc[c * 300 + j] - qc[c * 300 + i]);
+      for (std::size_t c = 0; c < 3; ++c)
+        r2 += (qc[c * 300 + j] - qc[c * 300 + i]) * (qc[c * 300 + j] - qc[c * 300 + i]);
       left += (r2.real() + 1e-4 < 0) ? 1 : 0;
     }
   EXPECT_GT(left, 1000);  // the test covers the branch
@@ -323,7 +324,8 @@ TEST(NBodyForce, LongDoubleAgreesWithDouble) {
   std::vector<double> a;
   f(p.s.q, a);
   fl(q, al);
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], static_cast<double>(al[i]), 1e-12 * (1 + std::abs(a[i])));
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_NEAR(a[i], static_cast<double>(al[i]), 1e-12 * (1 + std::abs(a[i])));
 }
 
 TEST(NBodyForce, IntegratesWithRealAndComplexSplittings) {
@@ -339,7 +341,10 @@ TEST(NBodyForce, IntegratesWithRealAndComplexSplittings) {
   const double dlf = std::abs(nbody_energy(f, s) - e0);
   EXPECT_LT(dlf, 1e-5);
   const C a1(0.25, 0.25 / std::sqrt(3.0));
-  SplittingScheme<C> ch{{{Flow::drift, a1}, {Flow::kick, 2.0 * a1}, {Flow::drift, C(0.5)}, {Flow::kick, std::conj(2.0 * a1)},
+  SplittingScheme<C> ch{{{Flow::drift, a1},
+                         {Flow::kick, 2.0 * a1},
+                         {Flow::drift, C(0.5)},
+                         {Flow::kick, std::conj(2.0 * a1)},
                          {Flow::drift, std::conj(a1)}}};
   SplittingStepper<std::vector<C>, NBodyForce<double>> sc(ch, f);
   auto z = convert_state<std::vector<C>>(p.s);
@@ -364,7 +369,8 @@ TEST(TwoBody, IsTheKeplerOrbitInTheCentreOfMassFrame) {
 }
 
 TEST(Plummer, IsReproducibleAndInStandardUnits) {
-  const auto a = plummer_sphere<double>(1000, 42), b = plummer_sphere<double>(1000, 42), c = plummer_sphere<double>(1000, 43);
+  const auto a = plummer_sphere<double>(1000, 42), b = plummer_sphere<double>(1000, 42),
+             c = plummer_sphere<double>(1000, 43);
   EXPECT_TRUE(a.s.q == b.s.q && a.s.v == b.s.v);
   EXPECT_FALSE(a.s.q == c.s.q);
   EXPECT_NEAR(particle_energy(a), -0.25, 1e-13);
@@ -392,9 +398,7 @@ TEST(ParticleFile, RoundTripsBitForBit) {
 TEST(ParticleFile, RejectsMalformedFiles) {
   const std::string path = temp_path("bad.csv");
   auto check = [&](const std::string& text, const std::string& what) {
-    {
-      std::ofstream(path) << text;
-    }
+    { std::ofstream(path) << text; }
     try {
       load_particles<double>(path);
       ADD_FAILURE() << "accepted: " << what;
@@ -411,13 +415,9 @@ TEST(ParticleFile, RejectsMalformedFiles) {
   check(ok + "0,0,0,0,0,0,0\n", "zero mass");
   check(ok + "1,0,0,nan,0,0,0\n", "nan");
   check(ok + "1,0,0,0.5.5,0,0,0\n", "two points");
-  {
-    std::ofstream(path) << "# only a comment\n\n";
-  }
+  { std::ofstream(path) << "# only a comment\n\n"; }
   EXPECT_THROW(load_particles<double>(path), std::invalid_argument);
-  {
-    std::ofstream(path) << "m,x,y,z,vx,vy,vz\n# c\n0.5 1 0 0 0 0.5 0\n\n0.5,-1,0,0,0,-0.5,0\n";
-  }
+  { std::ofstream(path) << "m,x,y,z,vx,vy,vz\n# c\n0.5 1 0 0 0 0.5 0\n\n0.5,-1,0,0,0,-0.5,0\n"; }
   const auto p = load_particles<double>(path);
   EXPECT_EQ(p.size(), 2u);
   EXPECT_EQ(p.s.v[2], 0.5);  // vy of particle 0
@@ -450,12 +450,19 @@ TEST(NBodyIntegration, SplittingsConvergeAtTheirOrders) {
   const double t_end = 0.125;
   const double theta = 1 / (2 - std::cbrt(2.0));
   const SplittingScheme<double> lf{{{Flow::kick, 0.5}, {Flow::drift, 1.0}, {Flow::kick, 0.5}}};
-  const SplittingScheme<double> fr{{{Flow::drift, theta / 2}, {Flow::kick, theta}, {Flow::drift, (1 - theta) / 2},
-                                    {Flow::kick, 1 - 2 * theta}, {Flow::drift, (1 - theta) / 2}, {Flow::kick, theta},
+  const SplittingScheme<double> fr{{{Flow::drift, theta / 2},
+                                    {Flow::kick, theta},
+                                    {Flow::drift, (1 - theta) / 2},
+                                    {Flow::kick, 1 - 2 * theta},
+                                    {Flow::drift, (1 - theta) / 2},
+                                    {Flow::kick, theta},
                                     {Flow::drift, theta / 2}}};
   const C a1(0.25, 0.25 / std::sqrt(3.0));
-  const SplittingScheme<C> ch{{{Flow::drift, a1}, {Flow::kick, 2.0 * a1}, {Flow::drift, C(0.5)},
-                               {Flow::kick, std::conj(2.0 * a1)}, {Flow::drift, std::conj(a1)}}};
+  const SplittingScheme<C> ch{{{Flow::drift, a1},
+                               {Flow::kick, 2.0 * a1},
+                               {Flow::drift, C(0.5)},
+                               {Flow::kick, std::conj(2.0 * a1)},
+                               {Flow::drift, std::conj(a1)}}};
   auto run_real = [&](const SplittingScheme<double>& m, long n) {
     SplittingStepper<std::vector<double>, NBodyForce<double>> st(m, f);
     auto s = p.s;
@@ -522,7 +529,8 @@ TEST(NBodyDeterminism, RunsAreBitwiseIndependentOfThreadsAndRepeatable) {
       const auto ref = run(1);
       for (int t : {1, 2, 3}) {
         const auto s = run(t);
-        EXPECT_TRUE(s.q == ref.q && s.v == ref.v) << name << ", " << t << " threads, kernel " << static_cast<int>(kernel);
+        EXPECT_TRUE(s.q == ref.q && s.v == ref.v)
+            << name << ", " << t << " threads, kernel " << static_cast<int>(kernel);
       }
     }
   }

@@ -63,14 +63,14 @@ namespace {
 
 struct OrderOptions {
   double ecc = 0.5;
-  double t_end = 2.5;             // 0.4 of an orbit, before the pericentre (t = pi); see the top of the file
-  long n_start = 2;               // first number of steps tried
-  long n_max = 1L << 21;          // no run longer than this many steps
-  double pre_asymptotic = 1e-3;   // errors above this are not used
-  double settled = 0.05;          // stop once the last three slopes agree this well and err < sqrt(eps)
-  double agree = 0.15;            // asymptotic: the last two slopes agree this well
-  double floor_per_step = 100;    // round-off floor: floor_per_step * N * epsilon_of<T>() ...
-  double floor_per_digit = 1e2;   // ... and floor_per_digit * 10^-published_digits (0: exact coefficients)
+  double t_end = 2.5;            // 0.4 of an orbit, before the pericentre (t = pi); see the top of the file
+  long n_start = 2;              // first number of steps tried
+  long n_max = 1L << 21;         // no run longer than this many steps
+  double pre_asymptotic = 1e-3;  // errors above this are not used
+  double settled = 0.05;         // stop once the last three slopes agree this well and err < sqrt(eps)
+  double agree = 0.15;           // asymptotic: the last two slopes agree this well
+  double floor_per_step = 100;   // round-off floor: floor_per_step * N * epsilon_of<T>() ...
+  double floor_per_digit = 1e2;  // ... and floor_per_digit * 10^-published_digits (0: exact coefficients)
 };
 
 struct OrderPoint {
@@ -81,17 +81,18 @@ struct OrderPoint {
 
 struct OrderMeasurement {
   std::string precision;
-  std::vector<OrderPoint> points;  // the usable points, coarse to fine
-  std::vector<OrderPoint> tried;   // every run, for the log
+  std::vector<OrderPoint> points;                              // the usable points, coarse to fine
+  std::vector<OrderPoint> tried;                               // every run, for the log
   double observed = std::numeric_limits<double>::quiet_NaN();  // slope between the last two usable points
-  bool asymptotic = false;         // the last two slopes agree within OrderOptions::agree
+  bool asymptotic = false;                                     // the last two slopes agree within OrderOptions::agree
   std::string log() const {
     std::ostringstream os;
     os << std::setprecision(4) << "  in " << precision << ":\n";
     const OrderPoint* prev = nullptr;
     for (const auto& p : tried) {
       os << "  N=" << p.steps << " h=" << p.h << " err=" << p.error;
-      if (prev && prev->error > 0 && p.error > 0) os << " slope=" << std::log(prev->error / p.error) / std::log(prev->h / p.h);
+      if (prev && prev->error > 0 && p.error > 0)
+        os << " slope=" << std::log(prev->error / p.error) / std::log(prev->h / p.h);
       os << "\n";
       prev = &p;
     }
@@ -175,7 +176,8 @@ OrderMeasurement measure_order(const MethodDef& def, int order_hint, const Order
     }
     const std::size_t ns = slopes.size();
     auto settled_within = [&](double tol) {
-      return ns >= 3 && std::abs(slopes[ns - 1] - slopes[ns - 2]) < tol && std::abs(slopes[ns - 2] - slopes[ns - 3]) < tol;
+      return ns >= 3 && std::abs(slopes[ns - 1] - slopes[ns - 2]) < tol &&
+             std::abs(slopes[ns - 2] - slopes[ns - 3]) < tol;
     };
     m.asymptotic = ns >= 2 && std::abs(slopes[ns - 1] - slopes[ns - 2]) < o.agree;
     if (settled_within(o.settled) && err < deep) break;
@@ -235,8 +237,8 @@ TEST_P(ObservedOrder, MatchesDeclaredOrder) {
   const auto m = measure_catalog_order(def);
   RecordProperty("observed_order", std::to_string(m.observed));
   std::ostringstream line;
-  line << "[ order    ] " << std::left << std::setw(16) << def.info.name << " declared " << std::setw(2) << def.info.order
-       << "  observed " << std::fixed << std::setprecision(3) << m.observed << "  (" << m.precision
+  line << "[ order    ] " << std::left << std::setw(16) << def.info.name << " declared " << std::setw(2)
+       << def.info.order << "  observed " << std::fixed << std::setprecision(3) << m.observed << "  (" << m.precision
        << (def.info.complex ? ", complex" : "") << ")";
   if (def.info.complex && m.observed > def.info.order + 0.5) line << "  one order more: imaginary leading error term";
   std::cout << line.str() << std::endl;
@@ -272,16 +274,22 @@ namespace {
 /// Forest-Ruth (position-first) with the first drift lengthened by delta and the second shortened by
 /// delta: still consistent (drifts and kicks each sum to 1), but no longer symmetric, so only first order.
 MethodDef perturbed_forest_ruth(const std::string& delta) {
-  MethodInfo info{.name = "FR-perturbed", .family = "splitting", .order = 4, .symmetric = false, .symplectic = true,
-                  .source = "test", .description = "Forest-Ruth with one drift perturbed", .aliases = {}};
-  MethodDef d{info, [delta] {
-                const bigfloat theta = 1 / (2 - boost::multiprecision::cbrt(bigfloat(2)));
-                const bigfloat half = big("1/2");
-                const bigfloat dl = big(delta);
-                return MethodData{scheme({drift(theta * half + dl), kick(theta), drift((1 - theta) * half - dl),
-                                          kick(1 - 2 * theta), drift((1 - theta) * half), kick(theta),
-                                          drift(theta * half)})};
-              }};
+  MethodInfo info{.name = "FR-perturbed",
+                  .family = "splitting",
+                  .order = 4,
+                  .symmetric = false,
+                  .symplectic = true,
+                  .source = "test",
+                  .description = "Forest-Ruth with one drift perturbed",
+                  .aliases = {}};
+  MethodDef d{
+      info, [delta] {
+        const bigfloat theta = 1 / (2 - boost::multiprecision::cbrt(bigfloat(2)));
+        const bigfloat half = big("1/2");
+        const bigfloat dl = big(delta);
+        return MethodData{scheme({drift(theta * half + dl), kick(theta), drift((1 - theta) * half - dl),
+                                  kick(1 - 2 * theta), drift((1 - theta) * half), kick(theta), drift(theta * half)})};
+      }};
   nystrom::detail::finalize_info(d);
   return d;
 }
@@ -289,12 +297,19 @@ MethodDef perturbed_forest_ruth(const std::string& delta) {
 /// Albrecht's A6 with velocity weights B_2 += delta, B_4 -= delta: sum B_i = 1 still holds but
 /// sum B_i c_i = 1/2 (the second-order condition) is off by -delta/2, so only first order.
 MethodDef perturbed_a6(const std::string& delta) {
-  MethodInfo info{.name = "A6-perturbed", .family = "rkn", .order = 6, .symmetric = false, .symplectic = false,
-                  .source = "test", .description = "A6 with two velocity weights perturbed", .aliases = {}};
+  MethodInfo info{.name = "A6-perturbed",
+                  .family = "rkn",
+                  .order = 6,
+                  .symmetric = false,
+                  .symplectic = false,
+                  .source = "test",
+                  .description = "A6 with two velocity weights perturbed",
+                  .aliases = {}};
   MethodDef d{info, [delta] {
-                auto t = tableau({"0", "1/4", "1/2", "3/4", "1"},
-                                 {{}, {"1/32"}, {"-1/24", "4/24"}, {"3/32", "4/32", "2/32"}, {"0", "6/14", "-1/14", "2/14"}},
-                                 {"7/90", "24/90", "6/90", "8/90", "0"}, {"7/90", "32/90", "12/90", "32/90", "7/90"});
+                auto t =
+                    tableau({"0", "1/4", "1/2", "3/4", "1"},
+                            {{}, {"1/32"}, {"-1/24", "4/24"}, {"3/32", "4/32", "2/32"}, {"0", "6/14", "-1/14", "2/14"}},
+                            {"7/90", "24/90", "6/90", "8/90", "0"}, {"7/90", "32/90", "12/90", "32/90", "7/90"});
                 t.B[1] += bigcomplex(big(delta));
                 t.B[3] += bigcomplex(-big(delta));
                 return MethodData{t};

@@ -59,19 +59,22 @@ void for_each_extended(Fn fn) {
 }  // namespace
 
 TEST(Precision, NamesAndBits) {
-  EXPECT_EQ(dispatch_precision("float128", [](auto t) { return scalar_traits<typename decltype(t)::type>::bits(); }), 113);
+  EXPECT_EQ(dispatch_precision("float128", [](auto t) { return scalar_traits<typename decltype(t)::type>::bits(); }),
+            113);
   EXPECT_EQ(dispatch_precision("dd", [](auto t) { return scalar_traits<typename decltype(t)::type>::bits(); }), 105);
   EXPECT_EQ(dispatch_precision("qd", [](auto t) { return scalar_traits<typename decltype(t)::type>::bits(); }), 210);
   // Boost 1.74 keeps the MPFR precision in decimal digits: mpfr:256 is 77 digits = 257 bits.
-  EXPECT_EQ(dispatch_precision("mpfr:256", [](auto t) { return scalar_traits<typename decltype(t)::type>::bits(); }), 257);
+  EXPECT_EQ(dispatch_precision("mpfr:256", [](auto t) { return scalar_traits<typename decltype(t)::type>::bits(); }),
+            257);
   EXPECT_EQ(dispatch_precision("mpfr:1000", [](auto t) { return scalar_traits<typename decltype(t)::type>::bits(); }),
             1001);  // 301 digits: Boost allocates 301 * 1000 / 301 + 1 bits
   for (const std::string name : {"float128", "dd", "qd", "mpfr:256"})
     EXPECT_EQ(dispatch_precision(name, [](auto t) { return scalar_traits<typename decltype(t)::type>::name(); }), name);
   EXPECT_EQ(dispatch_precision("quadruple", [](auto t) { return scalar_traits<typename decltype(t)::type>::name(); }),
             "float128");
-  EXPECT_EQ(dispatch_precision("double-double", [](auto t) { return scalar_traits<typename decltype(t)::type>::name(); }),
-            "dd");
+  EXPECT_EQ(
+      dispatch_precision("double-double", [](auto t) { return scalar_traits<typename decltype(t)::type>::name(); }),
+      "dd");
   EXPECT_EQ(dispatch_precision("quad-double", [](auto t) { return scalar_traits<typename decltype(t)::type>::name(); }),
             "qd");
 }
@@ -81,7 +84,7 @@ TEST(Precision, EffectiveMpfrBitsAreAtLeastTheRequestAndStable) {
     const unsigned d = MpfrPrecision::digits10_for(bits);
     const auto eff = boost::multiprecision::detail::digits10_2_2(d);
     ASSERT_GE(eff, static_cast<unsigned long>(bits));
-    ASSERT_LE(eff, static_cast<unsigned long>(bits) + 4) << bits;          // no coarser than Boost's digits10 grid
+    ASSERT_LE(eff, static_cast<unsigned long>(bits) + 4) << bits;            // no coarser than Boost's digits10 grid
     ASSERT_EQ(boost::multiprecision::detail::digits2_2_10(eff), d) << bits;  // results keep it (no drift)
   }
 }
@@ -181,7 +184,8 @@ TEST(Precision, DoubleDoubleProductsAreBitwiseLibqds) {
   auto same = [](const ::dd_real& x, const ::dd_real& y) { return x.x[0] == y.x[0] && x.x[1] == y.x[1]; };
   for (int k = 0; k < 2000; ++k) {
     const bool huge = k % 50 == 0;  // a beyond the threshold, b small enough for a finite product
-    const int ea = static_cast<int>(u(gen) * 500) + (huge ? 500 : 0), eb = static_cast<int>(u(gen) * 400) - (huge ? 500 : 0);
+    const int ea = static_cast<int>(u(gen) * 500) + (huge ? 500 : 0),
+              eb = static_cast<int>(u(gen) * 400) - (huge ? 500 : 0);
     const double a0 = std::ldexp(u(gen), ea), b0 = std::ldexp(u(gen), eb), d = std::ldexp(u(gen), eb);
     const double_double a = double_double(a0) + std::ldexp(u(gen), ea - 54);
     const double_double b = double_double(b0) + std::ldexp(u(gen), eb - 54);
@@ -215,7 +219,8 @@ TEST(Precision, InverseCubeOfTheRadiusIsAccurate) {
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<std::array<double, 4>> inputs;  // the components of r2, decreasing
   for (int k = 0; k < 3000; ++k) {
-    const int e = k < 2800 ? static_cast<int>(u(gen) * 1200) - 600 : (k % 2 ? 1 : -1) * (601 + static_cast<int>(u(gen) * 10));
+    const int e =
+        k < 2800 ? static_cast<int>(u(gen) * 1200) - 600 : (k % 2 ? 1 : -1) * (601 + static_cast<int>(u(gen) * 10));
     const double m = k % 10 == 0 ? 1.0 : 1 + 3 * u(gen);  // every tenth a power of 2 (or 4)
     const bool lows = k % 20 != 0;
     inputs.push_back({std::ldexp(m, e), lows ? std::ldexp(u(gen) - 0.5, e - 53) : 0.0,
@@ -280,7 +285,7 @@ TEST(Precision, VeryWideMpfrRuns) {
   });
   const auto qd = run_kepler<quad_double>(def, 0.5, 64, 1);
   EXPECT_EQ(wide.precision, "mpfr:2000");
-  EXPECT_GT(std::abs(qd.precession_per_period), 1e-12);  // a visible method error ...
+  EXPECT_GT(std::abs(qd.precession_per_period), 1e-12);                      // a visible method error ...
   EXPECT_NEAR(wide.precession_per_period, qd.precession_per_period, 1e-40);  // ... identical in both
   EXPECT_NEAR(wide.energy_error, qd.energy_error, 1e-40);
 }
@@ -308,7 +313,8 @@ TEST(Precision, ComplexKeplerForceIsAccurate) {
       std::array<C, 2> q, a;
       {
         BigPrecision wide(700);
-        q = {C(to_real<T>(big(qs[k][0])), to_real<T>(big(imag[k]))), C(to_real<T>(big(qs[k][1])), to_real<T>(big("1/7")))};
+        q = {C(to_real<T>(big(qs[k][0])), to_real<T>(big(imag[k]))),
+             C(to_real<T>(big(qs[k][1])), to_real<T>(big("1/7")))};
       }
       KeplerForce{}(q, a);  // at the working precision
       BigPrecision wide(700);
@@ -396,7 +402,8 @@ TEST(Precision, PrecisionBeyondUnrefinableCoefficientsIsAClearError) {
   n4.info.name = "N4-decimal";
   n4.info.published_digits = 16;
   n4.build = [] {
-    return MethodData{tableau({"0", "0.5", "1"}, {{}, {"0.125"}, {"0", "0.5"}}, {"0.1666666666666667", "0.3333333333333333", "0"},
+    return MethodData{tableau({"0", "0.5", "1"}, {{}, {"0.125"}, {"0", "0.5"}},
+                              {"0.1666666666666667", "0.3333333333333333", "0"},
                               {"0.1666666666666667", "0.6666666666666667", "0.1666666666666667"})};
   };
   EXPECT_NO_THROW(run_kepler<double>(n4, 0.5, 100, 1));
@@ -406,7 +413,8 @@ TEST(Precision, PrecisionBeyondUnrefinableCoefficientsIsAClearError) {
       run_kepler<T>(n4, 0.5, 100, 1);
       ADD_FAILURE() << "no error";
     } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("published with 16 digits, too few for " + name), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("published with 16 digits, too few for " + name), std::string::npos)
+          << e.what();
     }
   });
 }

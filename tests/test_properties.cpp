@@ -208,9 +208,9 @@ TEST_P(Symmetry, DeclaredSymmetricMethodsRetraceTheirSteps) {
   const MethodDef& def = find_in_catalog(GetParam());
   if (def.info.adaptive) GTEST_SKIP() << def.info.name << " is adaptive (its own step-size controller)";
   const double ulps = reversal_defect_ulps(def, kStep);
-  std::cout << "[ reverse  ] " << std::left << std::setw(16) << def.info.name << (def.info.symmetric ? " symmetric " : " -         ")
-            << " order " << std::setw(2) << def.info.order << "  defect " << std::setprecision(3) << ulps << " ulps"
-            << std::endl;
+  std::cout << "[ reverse  ] " << std::left << std::setw(16) << def.info.name
+            << (def.info.symmetric ? " symmetric " : " -         ") << " order " << std::setw(2) << def.info.order
+            << "  defect " << std::setprecision(3) << ulps << " ulps" << std::endl;
   if (def.info.symmetric) {
     EXPECT_LT(ulps, kReversalUlps) << def.info.name << " is declared symmetric but does not retrace its step";
   } else if (def.info.order <= 6 && !def.info.complex) {
@@ -221,8 +221,8 @@ TEST_P(Symmetry, DeclaredSymmetricMethodsRetraceTheirSteps) {
     // dropped such a method retraces its step up to O(z^2), z = O(h^6) the imaginary part of one
     // step (measured: AC1-6 2 ulps, AC1 150, BC2 3e4; Chambers, third order, 1e10). Section (c) asserts
     // all of these in quad-double, with the orders of their defects.
-    EXPECT_GT(ulps, 1000 * kReversalUlps) << def.info.name
-                                          << " is declared non-symmetric but retraces its step: is it symmetric?";
+    EXPECT_GT(ulps, 1000 * kReversalUlps)
+        << def.info.name << " is declared non-symmetric but retraces its step: is it symmetric?";
   }
 }
 
@@ -348,12 +348,15 @@ TEST_P(Symplecticity, DeclaredSymplecticMethodsPreserveTheSymplecticForm) {
     EXPECT_EQ(hh.value[i], plain_hh[i]) << def.info.name << " Henon-Heiles component " << i;
   }
   const double ulps_kep = symplectic_defect_ulps(kep.J), ulps_hh = symplectic_defect_ulps(hh.J);
-  std::cout << "[ symplect ] " << std::left << std::setw(16) << def.info.name << (def.info.symplectic ? " symplectic " : " -          ")
-            << " order " << std::setw(2) << def.info.order << "  defect Kepler " << std::setprecision(3) << std::setw(9)
-            << ulps_kep << " Henon-Heiles " << ulps_hh << " ulps" << std::endl;
+  std::cout << "[ symplect ] " << std::left << std::setw(16) << def.info.name
+            << (def.info.symplectic ? " symplectic " : " -          ") << " order " << std::setw(2) << def.info.order
+            << "  defect Kepler " << std::setprecision(3) << std::setw(9) << ulps_kep << " Henon-Heiles " << ulps_hh
+            << " ulps" << std::endl;
   if (def.info.symplectic) {
-    EXPECT_LT(ulps_kep, kSymplecticUlps) << def.info.name << " is declared symplectic but J^T Omega J != Omega (Kepler)";
-    EXPECT_LT(ulps_hh, kSymplecticUlps) << def.info.name << " is declared symplectic but J^T Omega J != Omega (Henon-Heiles)";
+    EXPECT_LT(ulps_kep, kSymplecticUlps) << def.info.name
+                                         << " is declared symplectic but J^T Omega J != Omega (Kepler)";
+    EXPECT_LT(ulps_hh, kSymplecticUlps) << def.info.name
+                                        << " is declared symplectic but J^T Omega J != Omega (Henon-Heiles)";
   } else if (def.info.order <= 8) {
     // Defects of high order in h, yet far above rounding up to order 8 (measured, the larger of the
     // two problems: >= 4e11 ulps; M10 2e9, DP10 2e7). The high-order MPE methods are symplectic to
@@ -397,7 +400,8 @@ TEST(SymplecticityControl, DualJacobianMatchesFiniteDifferences) {
       const auto fp = real_step(def, xp, kStep), fm = real_step(def, xm, kStep);
       for (int i = 0; i < 4; ++i) {
         const long double fd = (fp[i] - fm[i]) / (2 * delta);
-        EXPECT_NEAR(static_cast<double>(d.J[i][k]), static_cast<double>(fd), 1e-8) << name << " J[" << i << "][" << k << "]";
+        EXPECT_NEAR(static_cast<double>(d.J[i][k]), static_cast<double>(fd), 1e-8)
+            << name << " J[" << i << "][" << k << "]";
         off_identity = std::max(off_identity, std::abs(d.J[i][k] - (i == k ? 1.0L : 0.0L)));
       }
     }

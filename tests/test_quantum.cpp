@@ -186,8 +186,8 @@ TEST(QuantumImaginaryTime, GroundStateEnergyConvergesAtTwiceTheOrder1D) {
 }
 
 TEST(QuantumImaginaryTime, GroundStateEnergy3D) {
-  for (const auto& [method, order, h] : std::vector<std::tuple<std::string, int, double>>{
-           {"PV", 2, 0.4}, {"M4", 4, 0.8}, {"BC1", 5, 1.6}}) {
+  for (const auto& [method, order, h] :
+       std::vector<std::tuple<std::string, int, double>>{{"PV", 2, 0.4}, {"M4", 4, 0.8}, {"BC1", 5, 1.6}}) {
     const double e1 = ground_state_energy_error<double>(3, 28, 14, method, h, 20);
     const double e2 = ground_state_energy_error<double>(3, 28, 14, method, h / 2, 20);
     const double slope = std::log2(e1 / e2);

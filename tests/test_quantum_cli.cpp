@@ -30,9 +30,8 @@ std::string slurp(const std::filesystem::path& p) {
 }
 
 std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() /
-           ("nystrom-quantum-cli-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  auto d = std::filesystem::temp_directory_path() / ("nystrom-quantum-cli-" + std::to_string(::getpid()) + "-" +
+                                                     ::testing::UnitTest::GetInstance()->current_test_info()->name());
   std::filesystem::create_directories(d);
   return d;
 }
@@ -41,8 +40,8 @@ Result run(const std::string& args) {
   const char* b = std::getenv("NYSTROM_BIN");
   const auto dir = temp_dir();
   const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = std::string(b ? b : "nystrom") + " " + args + " >" + out.string() + " 2>" + err.string() +
-                          " </dev/null";
+  const std::string cmd =
+      std::string(b ? b : "nystrom") + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
   const int status = std::system(cmd.c_str());
   Result r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -54,12 +53,13 @@ Result run(const std::string& args) {
 }  // namespace
 
 TEST(QuantumCli, ContractCommandGivesTheCoherentState) {
-  const auto r = run("quantum --potential harmonic --dims 1 --grid 256 --box 20 --method M8 --dt 0.05 --steps 200 "
-                     "--x0 1 --p0 0 --json");
+  const auto r =
+      run("quantum --potential harmonic --dims 1 --grid 256 --box 20 --method M8 --dt 0.05 --steps 200 "
+          "--x0 1 --p0 0 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  for (const char* k : {"method", "dims", "grid", "dt", "steps", "norm", "energy", "mean_position", "time",
-                        "fft_count", "seconds"})
+  for (const char* k :
+       {"method", "dims", "grid", "dt", "steps", "norm", "energy", "mean_position", "time", "fft_count", "seconds"})
     EXPECT_TRUE(j.contains(k)) << k;
   EXPECT_EQ(j["method"], "M8");
   EXPECT_EQ(j["dims"], 1);
@@ -68,7 +68,7 @@ TEST(QuantumCli, ContractCommandGivesTheCoherentState) {
   EXPECT_NEAR(j["time"].get<double>(), 10.0, 1e-12);
   ASSERT_EQ(j["mean_position"].size(), 1u);
   EXPECT_NEAR(j["mean_position"][0].get<double>(), std::cos(10.0), 1e-8);  // the classical orbit
-  EXPECT_NEAR(j["energy"].get<double>(), 1.0, 1e-8);                        // 1/2 + x0^2/2
+  EXPECT_NEAR(j["energy"].get<double>(), 1.0, 1e-8);                       // 1/2 + x0^2/2
   EXPECT_NEAR(j["norm"].get<double>(), 1.0, 1e-7);
   EXPECT_LT(j["exact_error"].get<double>(), 1e-7);
   // M8 = mpe:1,2,3,4 over position Verlet: 4 products with 2, 3, 4, 5 kinetic sub-steps, two FFTs each
@@ -76,8 +76,9 @@ TEST(QuantumCli, ContractCommandGivesTheCoherentState) {
 }
 
 TEST(QuantumCli, ImaginaryTimeGroundState3DAndLongDouble) {
-  const auto r = run("quantum --dims 3 --grid 24 --box 12 --method BC1 --dt 0.2 --steps 100 --imaginary-time "
-                     "--x0 0.5 --precision long-double --json");
+  const auto r =
+      run("quantum --dims 3 --grid 24 --box 12 --method BC1 --dt 0.2 --steps 100 --imaginary-time "
+          "--x0 0.5 --precision long-double --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_NEAR(j["energy"].get<double>(), 1.5, 1e-8);
@@ -96,10 +97,9 @@ TEST(QuantumCli, PlotWritesAPng) {
 
 TEST(QuantumCli, BadInputExitsTwoWithOneLine) {
   const auto dir = temp_dir();
-  for (const std::string args :
-       {"--grid 0", "--grid -4", "--box 0", "--box -3", "--box nan", "--dt nan", "--dt 0", "--potential nowhere",
-        "--method A6", "--method DP12", "--method nonsense", "--dims 4", "--precision float", "--x0 1,2",
-        "--g inf", "--steps -1", "--grid abc"}) {
+  for (const std::string args : {"--grid 0", "--grid -4", "--box 0", "--box -3", "--box nan", "--dt nan", "--dt 0",
+                                 "--potential nowhere", "--method A6", "--method DP12", "--method nonsense", "--dims 4",
+                                 "--precision float", "--x0 1,2", "--g inf", "--steps -1", "--grid abc"}) {
     const auto r = run("quantum " + args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.err;
     EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;

@@ -72,7 +72,7 @@ TEST(Refine, WhenPublishedDigitsSuffice) {
   EXPECT_TRUE(published_digits_suffice(26, 64));
   EXPECT_FALSE(published_digits_suffice(26, 105));
   EXPECT_FALSE(published_digits_suffice(26, 113));
-  EXPECT_TRUE(published_digits_suffice(15, 53));   // 49.8 bits: within 16 ulps of double
+  EXPECT_TRUE(published_digits_suffice(15, 53));  // 49.8 bits: within 16 ulps of double
   EXPECT_FALSE(published_digits_suffice(14, 53));
   EXPECT_FALSE(published_digits_suffice(16, 64));  // long double needs 19
   EXPECT_TRUE(published_digits_suffice(19, 64));
@@ -115,10 +115,11 @@ TEST(Refine, EveryDecimalSplittingRefinesTo256Bits) {
       EXPECT_LE(change, 100 * unit) << "change " << short_str(change) << ", published unit " << short_str(unit);
     }
     EXPECT_GT(change, 0);  // the published digits were not already the solution
-    std::printf("  %-8s %2zu parameters, %3zu equations (%2zu independent), %d Newton steps, published residual %s, "
-                "refined %s, largest change %s, %.2f s\n",
-                d.info.name.c_str(), r.parameters.size(), r.equations, r.independent, r.iterations,
-                short_str(r.published_residual).c_str(), short_str(r.residual).c_str(), short_str(change).c_str(), secs);
+    std::printf(
+        "  %-8s %2zu parameters, %3zu equations (%2zu independent), %d Newton steps, published residual %s, "
+        "refined %s, largest change %s, %.2f s\n",
+        d.info.name.c_str(), r.parameters.size(), r.equations, r.independent, r.iterations,
+        short_str(r.published_residual).c_str(), short_str(r.residual).c_str(), short_str(change).c_str(), secs);
   }
 }
 
@@ -159,13 +160,15 @@ TEST(Refine, SolutionIsIndependentOfPrecisionAndStrategy) {
 // method_data_for: published tables where their digits suffice, refined ones (cached) beyond.
 TEST(Refine, MethodDataForUsesPublishedOrRefinedCoefficients) {
   const auto def = resolve_method("KL8");
-  auto coef = [](const MethodData& d, std::size_t k) { return std::get<SplittingScheme<bigcomplex>>(d).steps.at(k).coef.re; };
+  auto coef = [](const MethodData& d, std::size_t k) {
+    return std::get<SplittingScheme<bigcomplex>>(d).steps.at(k).coef.re;
+  };
   const MethodData dbl = method_data_for(def, 53, "double");
   const MethodData quad = method_data_for(def, 113, "float128");
   BigPrecision guard(256);
   const MethodData pub = def.build();
-  EXPECT_TRUE(coef(dbl, 1) == coef(pub, 1));    // 26 digits are plenty for double
-  EXPECT_FALSE(coef(quad, 1) == coef(pub, 1));  // float128 gets the refined set ...
+  EXPECT_TRUE(coef(dbl, 1) == coef(pub, 1));                        // 26 digits are plenty for double
+  EXPECT_FALSE(coef(quad, 1) == coef(pub, 1));                      // float128 gets the refined set ...
   EXPECT_LE(abs(coef(quad, 1) - coef(pub, 1)), bigfloat("1e-25"));  // ... close to the published one
   EXPECT_LE(condition_defect(std::get<SplittingScheme<bigcomplex>>(quad), 8), ldexp(bigfloat(1), 32 - 256));
   const auto t0 = std::chrono::steady_clock::now();
@@ -203,7 +206,8 @@ TEST(Refine, DecimalRknTableauBeyondItsDigitsIsRefused) {
   n4.info.name = "N4-decimal";
   n4.info.published_digits = 16;
   n4.build = [] {
-    return MethodData{tableau({"0", "0.5", "1"}, {{}, {"0.125"}, {"0", "0.5"}}, {"0.1666666666666667", "0.3333333333333333", "0"},
+    return MethodData{tableau({"0", "0.5", "1"}, {{}, {"0.125"}, {"0", "0.5"}},
+                              {"0.1666666666666667", "0.3333333333333333", "0"},
                               {"0.1666666666666667", "0.6666666666666667", "0.1666666666666667"})};
   };
   EXPECT_NO_THROW(method_data_for(n4, 53, "double"));

@@ -88,7 +88,6 @@ const std::vector<std::string> kTargets{"chin-fig1",     "chin-fig2",     "chin-
                                         "gurkan-fig5.1", "gurkan-fig5.2", "gurkan-table5.1", "gurkan-fig5.3"};
 
 void check_files_and_report(const fs::path& out) {
-
   const auto summary = nlohmann::json::parse(slurp(out / "summary.json"));
   std::set<std::string> names;
   for (const auto& t : summary["targets"]) {

@@ -89,7 +89,7 @@ SplittingScheme<bigcomplex> gurkan_ar1() {
 SplittingScheme<bigcomplex> gurkan_br1() {
   const char* al[] = {"0.54200976680171613", "-0.04060817665564392", "-0.87779698530109766", "0.86474236062251646",
                       "0.51165303453250898"};
-  const char* be[] = {"0.24566294009066009", "1.1433587581365421",    "-1.3796706973507000",
+  const char* be[] = {"0.24566294009066009",   "1.1433587581365421",  "-1.3796706973507000",
                       "-0.019611260781217307", "0.87087215441178844", "0.13938810549292669"};
   SplittingScheme<bigcomplex> s;
   for (int i = 0; i < 5; ++i) {
@@ -149,9 +149,8 @@ TEST(SnTrees, SmallTreesTheirDensitiesAndConditionCounts) {
   ASSERT_EQ(t.size(), 7u);
   std::map<std::string, std::uint64_t> gamma;
   for (const auto& x : t) gamma[x.name] = x.gamma;
-  const std::map<std::string, std::uint64_t> expect = {{"f", 1},           {"f'(v)", 2},    {"f'(f)", 6},
-                                                       {"f''(v,v)", 3},    {"f'(f'(v))", 24}, {"f''(f,v)", 8},
-                                                       {"f'''(v,v,v)", 4}};
+  const std::map<std::string, std::uint64_t> expect = {
+      {"f", 1}, {"f'(v)", 2}, {"f'(f)", 6}, {"f''(v,v)", 3}, {"f'(f'(v))", 24}, {"f''(f,v)", 8}, {"f'''(v,v,v)", 4}};
   EXPECT_EQ(gamma, expect);
   // Conditions for order p: velocity for rho <= p, position for rho <= p - 1 (partial sums of the counts).
   const std::vector<std::size_t> cumulative = {1, 3, 6, 11, 20, 36, 66, 122};
@@ -227,7 +226,8 @@ TEST(RknOrderConditions, EveryCatalogTableauHasExactlyItsDeclaredOrder) {
     const int p = d.info.order;
     const double tol = declared_tolerance(d.info);
     const auto r = residuals_by_order(*t, p + 1);
-    EXPECT_LE(*std::max_element(r.begin(), r.end() - 1), tol) << d.info.name << ": a condition of order <= " << p << " fails";
+    EXPECT_LE(*std::max_element(r.begin(), r.end() - 1), tol)
+        << d.info.name << ": a condition of order <= " << p << " fails";
     EXPECT_GT(r.back(), 1e3 * tol) << d.info.name << " satisfies the conditions of order " << p + 1;
     ++checked;
   }
@@ -354,9 +354,8 @@ TEST(RknOrderConditions, ResidualVectorDrivesANewtonRefinement) {
   auto fr = [](const bigfloat& th) {
     const bigfloat h = big("1/2");
     SplittingScheme<bigfloat> s;
-    s.steps = {{Flow::drift, th * h},          {Flow::kick, th},         {Flow::drift, (1 - th) * h},
-               {Flow::kick, 1 - 2 * th},       {Flow::drift, (1 - th) * h}, {Flow::kick, th},
-               {Flow::drift, th * h}};
+    s.steps = {{Flow::drift, th * h},       {Flow::kick, th}, {Flow::drift, (1 - th) * h}, {Flow::kick, 1 - 2 * th},
+               {Flow::drift, (1 - th) * h}, {Flow::kick, th}, {Flow::drift, th * h}};
     return rkn_residual_vector(to_rkn_tableau(s), 4);
   };
   const bigfloat exact = 1 / (2 - boost::multiprecision::cbrt(bigfloat(2)));
@@ -443,11 +442,8 @@ TEST(ToRknTableau, StructureOfTheConversion) {
   EXPECT_EQ(pv.b[0], big("1/2"));
   EXPECT_EQ(pv.B[0], 1);
   // Adjacent kicks merge; a_ij = B_j (c_i - c_j).
-  const auto t = real_tableau(to_rkn_tableau(scheme_of({{Flow::kick, "1/4"},
-                                                        {Flow::kick, "1/4"},
-                                                        {Flow::drift, "1/3"},
-                                                        {Flow::kick, "1/2"},
-                                                        {Flow::drift, "2/3"}})));
+  const auto t = real_tableau(to_rkn_tableau(scheme_of(
+      {{Flow::kick, "1/4"}, {Flow::kick, "1/4"}, {Flow::drift, "1/3"}, {Flow::kick, "1/2"}, {Flow::drift, "2/3"}})));
   ASSERT_EQ(t.stages(), 2u);
   EXPECT_EQ(t.B[0], big("1/2"));
   EXPECT_EQ(t.a[1][0], big("1/2") * big("1/3"));

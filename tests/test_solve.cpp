@@ -44,10 +44,14 @@ TEST(Solve, EveryFamilyReachesTheAnalyticKeplerOrbit) {
     double tol;
   };
   const std::vector<Case> cases = {
-      {"VV", {.steps = 20000}, 1e-6},          {"FR", {.steps = 2000}, 1e-6},
-      {"M8", {.steps = 400}, 1e-9},            {"A6", {.h = 0.003}, 1e-9},
-      {"DP12-adaptive", {.rtol = 1e-12}, 1e-9}, {"M12-adaptive", {.rtol = 1e-12}, 1e-9},
-      {"GBS", {.rtol = 1e-12}, 1e-9},          {"Chambers", {.steps = 20000}, 1e-6},
+      {"VV", {.steps = 20000}, 1e-6},
+      {"FR", {.steps = 2000}, 1e-6},
+      {"M8", {.steps = 400}, 1e-9},
+      {"A6", {.h = 0.003}, 1e-9},
+      {"DP12-adaptive", {.rtol = 1e-12}, 1e-9},
+      {"M12-adaptive", {.rtol = 1e-12}, 1e-9},
+      {"GBS", {.rtol = 1e-12}, 1e-9},
+      {"Chambers", {.steps = 20000}, 1e-6},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.method);
@@ -251,7 +255,8 @@ TEST(SolveEvents, KeplerPericentreAndApocentrePassagesAreTheAnalyticOnes) {
     const double tol = m == "M8" ? 1e-11 : m == "GBS" ? 1e-3 : 1e-8;
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(peri[i], (2 * i + 1) * pi, tol * (2 * i + 1) * pi);
     for (int i = 0; i < 2; ++i) EXPECT_NEAR(apo[i], 2 * (i + 1) * pi, tol * 2 * (i + 1) * pi);
-    for (int i = 0; i < 3; ++i) std::printf("%s pericentre %d: t - (2i+1) pi = %.2e\n", m.c_str(), i, peri[i] - (2 * i + 1) * pi);
+    for (int i = 0; i < 3; ++i)
+      std::printf("%s pericentre %d: t - (2i+1) pi = %.2e\n", m.c_str(), i, peri[i] - (2 * i + 1) * pi);
   }
 }
 

@@ -127,7 +127,8 @@ TEST(Threads, ConcurrentCoefficientBuildsAreBitwiseThoseOfOneThread) {
         const std::string where = kMethods[i / kBits.size()] + " at " + std::to_string(kBits[i % kBits.size()]) +
                                   " bits, thread " + std::to_string(t) + ", round " + std::to_string(r);
         ASSERT_EQ(have.size(), want.size()) << where;
-        for (std::size_t k = 0; k < want.size(); ++k) EXPECT_TRUE(same_bits(have[k], want[k])) << where << ", coefficient " << k;
+        for (std::size_t k = 0; k < want.size(); ++k)
+          EXPECT_TRUE(same_bits(have[k], want[k])) << where << ", coefficient " << k;
       }
 }
 

@@ -86,8 +86,8 @@ struct Outcome {
   long forces = 0;
   double seconds = 0;
   double error = std::numeric_limits<double>::infinity();  // inf: failed (budget, step-size failure, NaN)
-  bool ok = false;      // finished with a finite error
-  bool budget = false;  // stopped by the force-evaluation cap
+  bool ok = false;                                         // finished with a finite error
+  bool budget = false;                                     // stopped by the force-evaluation cap
 };
 
 /// One run: integrate from the start, fill the final state, the steps taken and the time reached.
@@ -124,11 +124,11 @@ struct PeerRun {
 struct PeerConfig {
   std::vector<double> eccs{0.5, 0.9};
   long periods = 100;
-  double spp_ratio = std::pow(2.0, 0.25);  // steps-per-period ratio of consecutive fixed-step runs
+  double spp_ratio = std::pow(2.0, 0.25);   // steps-per-period ratio of consecutive fixed-step runs
   double tol_ratio = std::pow(10.0, 0.25);  // tolerance ratio of consecutive adaptive runs (both libraries)
   double tol_max = 1e-3, tol_min = 1e-15;
-  long force_cap = 30'000'000;  // per run
-  double min_time = 0.2;        // repeat a run until this much time has been spent ...
+  long force_cap = 30'000'000;      // per run
+  double min_time = 0.2;            // repeat a run until this much time has been spent ...
   int min_reps = 3, max_reps = 20;  // ... at least min_reps times (1 for runs above long_run), at most max_reps
   double long_run = 0.5;
   double floor_error = 3e-16;  // stop a sweep once the error is below this
@@ -351,9 +351,9 @@ inline MethodSpec odeint_rkf78(double ecc, long periods) {
     return [ecc, periods, c](double spp) -> Run {
       const long k = static_cast<long>(spp);
       using Stepper = oi::runge_kutta_fehlberg78<Vec4>;
-      return odeint_fixed_run<Stepper, CountingKeplerSystem, Vec4>(CountingKeplerSystem{CountingKepler{c}},
-                                                                  to_vec4, from_vec4, ecc, k * periods,
-                                                                  period() / static_cast<double>(k));
+      return odeint_fixed_run<Stepper, CountingKeplerSystem, Vec4>(CountingKeplerSystem{CountingKepler{c}}, to_vec4,
+                                                                   from_vec4, ecc, k * periods,
+                                                                   period() / static_cast<double>(k));
     };
   };
   return m;
@@ -367,7 +367,8 @@ Run odeint_adaptive_run(MakeStepper make_stepper, ForceCounter* c, double ecc, l
     auto stepper = make_stepper();
     Vec4 y = to_vec4(start(ecc));
     t_end = period() * static_cast<double>(periods);
-    steps = static_cast<long>(oi::integrate_adaptive(stepper, CountingKeplerSystem{CountingKepler{c}}, y, 0.0, t_end, 1e-3));
+    steps = static_cast<long>(
+        oi::integrate_adaptive(stepper, CountingKeplerSystem{CountingKepler{c}}, y, 0.0, t_end, 1e-3));
     s = from_vec4(y);
   };
 }
@@ -376,8 +377,8 @@ inline MethodSpec odeint_dopri5(double ecc, long periods) {
   MethodSpec m = odeint_spec("runge_kutta_dopri5", "odeint dopri5", true, 5, 0, 0);
   m.make = [ecc, periods](ForceCounter* c) -> Prepare {
     return [ecc, periods, c](double tol) -> Run {
-      return odeint_adaptive_run([tol] { return oi::make_controlled(tol, tol, oi::runge_kutta_dopri5<Vec4>()); }, c, ecc,
-                                 periods);
+      return odeint_adaptive_run([tol] { return oi::make_controlled(tol, tol, oi::runge_kutta_dopri5<Vec4>()); }, c,
+                                 ecc, periods);
     };
   };
   return m;
@@ -408,8 +409,8 @@ inline std::vector<MethodSpec> peer_methods(double ecc, long periods) {
   m.push_back(nystrom_gbs(ecc, periods));
   for (const char* name : {"M8", "SS10", "DP12"}) m.push_back(nystrom_fixed(name, ecc, periods, false));
   m.push_back(odeint_verlet(ecc, periods));
-  m.push_back(odeint_symplectic<oi::symplectic_rkn_sb3a_mclachlan<Vec2>>(
-      "symplectic_rkn_sb3a_mclachlan", "odeint sb3a_mclachlan", 4, 6, ecc, periods));
+  m.push_back(odeint_symplectic<oi::symplectic_rkn_sb3a_mclachlan<Vec2>>("symplectic_rkn_sb3a_mclachlan",
+                                                                         "odeint sb3a_mclachlan", 4, 6, ecc, periods));
   m.push_back(odeint_symplectic<oi::symplectic_rkn_sb3a_m4_mclachlan<Vec2>>(
       "symplectic_rkn_sb3a_m4_mclachlan", "odeint sb3a_m4_mclachlan", 4, 5, ecc, periods));
   m.push_back(odeint_rkf78(ecc, periods));
@@ -527,8 +528,8 @@ inline std::vector<PeerRun> sweep_method(const MethodSpec& m, double ecc, const 
   // rule would stop odeint's rkf78 at e = 0.5 before its 1448 steps/period run, 2.2e-13).
   double best = std::numeric_limits<double>::infinity();
   int stale = 0;
-  const int stale_max = std::max(3, static_cast<int>(std::lround(m.adaptive ? 1.5 / std::log10(cfg.tol_ratio)
-                                                                            : 2.0 / std::log2(cfg.spp_ratio))));
+  const int stale_max = std::max(
+      3, static_cast<int>(std::lround(m.adaptive ? 1.5 / std::log10(cfg.tol_ratio) : 2.0 / std::log2(cfg.spp_ratio))));
   auto done = [&](double err) {
     if (err < best * 0.7) {
       best = err;

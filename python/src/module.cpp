@@ -122,8 +122,8 @@ py::dict method_coeffs(const std::string& spec, int digits) {
 }
 
 /// The BCH analysis of a splitting method, as `nystrom bch --json` gives it.
-py::dict bch(const std::string& method, int degree, const std::string& basis, const std::string& algebra,
-             unsigned bits, double tolerance) {
+py::dict bch(const std::string& method, int degree, const std::string& basis, const std::string& algebra, unsigned bits,
+             double tolerance) {
   namespace an = nystrom::analysis;
   an::check_degree(degree);
   if (bits < 64 || bits > 4096) throw std::invalid_argument("bits must be between 64 and 4096");
@@ -242,8 +242,8 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "optimal_mpe_sequence", [](int n, long sum) { return optimal_mpe_sequence(n, sum); }, py::arg("n"),
       py::arg("sum"));
-  m.def("bch", &bch, py::arg("method"), py::arg("degree") = 7, py::arg("basis") = "hall",
-        py::arg("algebra") = "rkn", py::arg("bits") = 192u, py::arg("tolerance") = 0.0,
+  m.def("bch", &bch, py::arg("method"), py::arg("degree") = 7, py::arg("basis") = "hall", py::arg("algebra") = "rkn",
+        py::arg("bits") = 192u, py::arg("tolerance") = 0.0,
         "BCH series of a splitting method: coefficients of H - Z per degree, order, leading error terms.");
   m.def("method_coeffs", &method_coeffs, py::arg("spec"), py::arg("digits") = 20,
         "The coefficients of a catalog method, as decimal strings.");
@@ -353,8 +353,8 @@ PYBIND11_MODULE(_core, m) {
       py::arg("keep_complex") = false);
   m.def(
       "python_stepper",
-      [](py::object fn, std::vector<py::ssize_t> shape, const std::string& method, double tol, double h0,
-         double h_max, long max_steps, bool keep_complex) {
+      [](py::object fn, std::vector<py::ssize_t> shape, const std::string& method, double tol, double h0, double h_max,
+         long max_steps, bool keep_complex) {
         const MethodDef def = resolve_method(method);
         const StepperOptions o = options(tol, h0, h_max, max_steps, keep_complex);
         std::size_t n = 1;

@@ -377,15 +377,13 @@ class StepperImpl final : public Stepper {
     using Mpe = std::monostate;
   };
   template <class W>
-    requires(!is_complex_v<typename W::value_type>)
-  struct AdaptiveTypes<W> {
+  requires(!is_complex_v<typename W::value_type>) struct AdaptiveTypes<W> {
     using Rkn = AdaptiveRknIntegrator<W, F>;
     using Mpe = AdaptiveMpeIntegrator<W, F>;
   };
   // Index 1: fixed steps; 2: adaptive RKN (embedded pair); 3: adaptive MPE. The monostates (index 0
   // before construction; 2 and 3 for complex states, which have no adaptive engine) are never run.
-  using Engine =
-      std::variant<std::monostate, Fixed, typename AdaptiveTypes<V>::Rkn, typename AdaptiveTypes<V>::Mpe>;
+  using Engine = std::variant<std::monostate, Fixed, typename AdaptiveTypes<V>::Rkn, typename AdaptiveTypes<V>::Mpe>;
 
   MethodDef def_;
   F force_;

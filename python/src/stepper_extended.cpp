@@ -9,8 +9,8 @@ std::unique_ptr<Stepper> make_builtin_stepper_extended(const std::string& proble
                                                        std::size_t n, const MethodDef& def, const StepperOptions& o,
                                                        const std::string& precision) {
   if (def.info.complex)
-    throw std::invalid_argument("complex-coefficient methods run in double only from Python (method '" +
-                                def.info.name + "')");
+    throw std::invalid_argument("complex-coefficient methods run in double only from Python (method '" + def.info.name +
+                                "')");
   if (precision.rfind("mpfr", 0) == 0)
     throw std::invalid_argument("precision '" + precision +
                                 "' is not available from Python (long-double, float128, dd and qd are)");

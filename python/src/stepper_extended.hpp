@@ -20,8 +20,8 @@ std::unique_ptr<Stepper> make_extended_stepper(const std::string& problem, const
   throw std::invalid_argument("problem '" + problem + "' runs in double only (extended precisions: Kepler)");
 }
 
-std::unique_ptr<Stepper> make_extended_stepper_long_double(const std::string&, const std::vector<double>&,
-                                                           std::size_t, const MethodDef&, const StepperOptions&);
+std::unique_ptr<Stepper> make_extended_stepper_long_double(const std::string&, const std::vector<double>&, std::size_t,
+                                                           const MethodDef&, const StepperOptions&);
 std::unique_ptr<Stepper> make_extended_stepper_float128(const std::string&, const std::vector<double>&, std::size_t,
                                                         const MethodDef&, const StepperOptions&);
 std::unique_ptr<Stepper> make_extended_stepper_dd(const std::string&, const std::vector<double>&, std::size_t,

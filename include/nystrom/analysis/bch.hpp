@@ -47,7 +47,8 @@ std::vector<std::pair<int, C>> operator_factors(const SplittingScheme<C>& s) {
 
 /// Coordinates of Z = log(product) per degree (coords[d], d = 1..N) in the structure's basis.
 template <class K>
-std::vector<std::vector<K>> bch_coordinates(const std::vector<std::pair<int, K>>& factors, const LieProjector<K>& proj) {
+std::vector<std::vector<K>> bch_coordinates(const std::vector<std::pair<int, K>>& factors,
+                                            const LieProjector<K>& proj) {
   return proj(log_of_product(factors, proj.structure().degree()));
 }
 template <class K>
@@ -74,7 +75,8 @@ inline bool recognise_rational(const bigfloat& x, mpq_class& out, long max_den =
   using boost::multiprecision::abs;
   using boost::multiprecision::floor;
   const int digits = static_cast<int>(bigfloat::default_precision());
-  const bigfloat tol = boost::multiprecision::pow(bigfloat(10), -(digits - 6)) * std::max<bigfloat>(bigfloat(1), abs(x));
+  const bigfloat tol =
+      boost::multiprecision::pow(bigfloat(10), -(digits - 6)) * std::max<bigfloat>(bigfloat(1), abs(x));
   mpz_class p0 = 0, q0 = 1, p1 = 1, q1 = 0;  // continued-fraction convergents
   bigfloat r = x;
   for (int it = 0; it < 80; ++it) {
@@ -136,12 +138,10 @@ struct MethodAnalysis {
   unsigned precision_bits = 0;
   double tolerance = 0;
   int declared_order = 0;
-  int order = 0;       // largest p with degrees 1..p vanishing (p = degree means "at least")
+  int order = 0;  // largest p with degrees 1..p vanishing (p = degree means "at least")
   bool order_is_lower_bound = false;
   std::vector<DegreeTerms> degrees;  // index d - 1 for degree d
-  const DegreeTerms* leading() const {
-    return order < degree ? &degrees[static_cast<std::size_t>(order)] : nullptr;
-  }
+  const DegreeTerms* leading() const { return order < degree ? &degrees[static_cast<std::size_t>(order)] : nullptr; }
   bool declared_order_confirmed() const {
     return declared_order <= 0 || (order == declared_order || (order_is_lower_bound && order >= declared_order));
   }
@@ -222,7 +222,8 @@ inline MethodAnalysis analyze_scheme(const SplittingScheme<bigcomplex>& scheme, 
     a.exact = true;
   } else {
     std::vector<std::pair<int, bigcomplex>> f;
-    for (const auto& [letter, c] : operator_factors(scheme)) f.emplace_back(letter, bigcomplex(bigfloat(c.re), bigfloat(c.im)));
+    for (const auto& [letter, c] : operator_factors(scheme))
+      f.emplace_back(letter, bigcomplex(bigfloat(c.re), bigfloat(c.im)));
     const double tol = opt.tolerance > 0 ? opt.tolerance : detail::default_tolerance(false, bits, published_digits);
     a = detail::fill_analysis(error_terms(bch_coordinates(f, s), s), s, tol);
   }

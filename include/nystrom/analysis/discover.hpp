@@ -96,8 +96,8 @@ RknVector<S> rkn5_conditions(RknForm form, const RknVector<S>& x) {
     t[9] += B[i] * inner * inner;  // sum_{j<i} sum_{l<i} B_i B_j B_l (c_i - c_j)(c_i - c_l)
   }
   static const std::array<mpq_class, 10> target{mpq_class(1),     mpq_class(1, 2), mpq_class(1, 3), mpq_class(1, 4),
-                                                 mpq_class(1, 5),  mpq_class(1, 6), mpq_class(1, 8), mpq_class(1, 10),
-                                                 mpq_class(1, 30), mpq_class(1, 20)};
+                                                mpq_class(1, 5),  mpq_class(1, 6), mpq_class(1, 8), mpq_class(1, 10),
+                                                mpq_class(1, 30), mpq_class(1, 20)};
   for (std::size_t k = 0; k < 10; ++k) t[k] = t[k] - from_rational<S>(target[k]);
   return t;
 }
@@ -433,9 +433,9 @@ struct DiscoveredMethod {
   int digits = 0;        // correct digits after polishing
   double residual = 0;   // max |t_k - target| after polishing
   MethodClass cls = MethodClass::other;
-  bool positive = false;        // every coefficient has a positive real part
-  bool skew_symmetric = false;  // reverse == conjugate
-  bool symmetric = false;       // reverse == itself
+  bool positive = false;           // every coefficient has a positive real part
+  bool skew_symmetric = false;     // reverse == conjugate
+  bool symmetric = false;          // reverse == itself
   std::vector<ErrorTerm> leading;  // degree-6 terms of H - Z (Hall basis, RKN algebra)
   double error_norm = 0;
   double max_abs_coefficient = 0;
@@ -444,8 +444,8 @@ struct DiscoveredMethod {
 
 struct DiscoverReport {
   DiscoverOptions options;
-  long converged = 0;      // starts that converged in double precision
-  long not_polished = 0;   // classes dropped: singular Jacobian (pivot ratio > 1e11) or no MPFR Newton convergence
+  long converged = 0;     // starts that converged in double precision
+  long not_polished = 0;  // classes dropped: singular Jacobian (pivot ratio > 1e11) or no MPFR Newton convergence
   std::vector<DiscoveredMethod> methods;  // sorted: REAL, IMAGINARY, OTHER; then by error norm
   long count(MethodClass c, bool positive_only = false) const {
     long n = 0;
@@ -506,10 +506,12 @@ void parallel_for(long n, int threads, Fn&& fn) {
 /// The random-start search for one scheme (see the top of the file). `progress` (optional) is called with
 /// the number of finished starts.
 inline DiscoverReport discover(const DiscoverOptions& opt, const std::function<void(long)>& progress = {}) {
-  if (opt.starts < 1 || opt.starts > 100000000L) throw std::invalid_argument("the number of starts must be between 1 and 1e8");
+  if (opt.starts < 1 || opt.starts > 100000000L)
+    throw std::invalid_argument("the number of starts must be between 1 and 1e8");
   if (!(opt.box > 0) || !std::isfinite(opt.box)) throw std::invalid_argument("the start box must be positive");
   if (opt.threads < 1 || opt.threads > 256) throw std::invalid_argument("threads must be between 1 and 256");
-  if (opt.polish_bits < 128 || opt.polish_bits > 4096) throw std::invalid_argument("polish precision must be 128..4096 bits");
+  if (opt.polish_bits < 128 || opt.polish_bits > 4096)
+    throw std::invalid_argument("polish precision must be 128..4096 bits");
   DiscoverReport rep;
   rep.options = opt;
   // 1. local solves in double
@@ -517,9 +519,8 @@ inline DiscoverReport discover(const DiscoverOptions& opt, const std::function<v
   std::atomic<long> done{0};
   std::mutex progress_mu;
   detail::parallel_for(opt.starts, opt.threads, [&](long k) {
-    sol[static_cast<std::size_t>(k)] =
-        solve_rkn_conditions(opt.form, random_start(opt.seed, static_cast<std::uint64_t>(k), opt.box), opt.solver,
-                             opt.max_iterations);
+    sol[static_cast<std::size_t>(k)] = solve_rkn_conditions(
+        opt.form, random_start(opt.seed, static_cast<std::uint64_t>(k), opt.box), opt.solver, opt.max_iterations);
     const long d = ++done;
     if (progress && (d % 64 == 0 || d == opt.starts)) {
       std::lock_guard<std::mutex> lock(progress_mu);
@@ -644,9 +645,11 @@ std::vector<C> skew_substeps(const std::vector<R>& x, std::size_t m) {
 // Constraints c (order conditions, one real per basis element of degrees 1..p) and objective r (degree p+1),
 // with their Jacobians with respect to the real parameters.
 template <class C, std::size_t M>
-void skew_system(const std::vector<typename complex_ops<C>::real>& x, Flow first, int order, const LieProjector<Dual<C, M>>& proj,
-                 std::vector<typename complex_ops<C>::real>& c, std::vector<std::vector<typename complex_ops<C>::real>>& jc,
-                 std::vector<typename complex_ops<C>::real>& r, std::vector<std::vector<typename complex_ops<C>::real>>& jr) {
+void skew_system(const std::vector<typename complex_ops<C>::real>& x, Flow first, int order,
+                 const LieProjector<Dual<C, M>>& proj, std::vector<typename complex_ops<C>::real>& c,
+                 std::vector<std::vector<typename complex_ops<C>::real>>& jc,
+                 std::vector<typename complex_ops<C>::real>& r,
+                 std::vector<std::vector<typename complex_ops<C>::real>>& jr) {
   using O = complex_ops<C>;
   using R = typename O::real;
   using D = Dual<C, M>;
@@ -703,9 +706,11 @@ R sumsq(const std::vector<R>& v) {
 
 // Restores c(x) = 0 by minimum-norm Newton steps dx = -Jc^T (Jc Jc^T)^{-1} c. Returns false if it fails.
 template <class C, std::size_t M>
-bool skew_restore(std::vector<typename complex_ops<C>::real>& x, Flow first, int order, const LieProjector<Dual<C, M>>& proj,
-                  double tol, std::vector<typename complex_ops<C>::real>& c, std::vector<std::vector<typename complex_ops<C>::real>>& jc,
-                  std::vector<typename complex_ops<C>::real>& r, std::vector<std::vector<typename complex_ops<C>::real>>& jr) {
+bool skew_restore(std::vector<typename complex_ops<C>::real>& x, Flow first, int order,
+                  const LieProjector<Dual<C, M>>& proj, double tol, std::vector<typename complex_ops<C>::real>& c,
+                  std::vector<std::vector<typename complex_ops<C>::real>>& jc,
+                  std::vector<typename complex_ops<C>::real>& r,
+                  std::vector<std::vector<typename complex_ops<C>::real>>& jr) {
   using R = typename complex_ops<C>::real;
   skew_system<C, M>(x, first, order, proj, c, jc, r, jr);
   auto cnorm = [](const std::vector<R>& v) {
@@ -848,7 +853,8 @@ int skew_reduced_newton(std::vector<typename complex_ops<C>::real>& x, Flow firs
   converged = false;
   if (!skew_restore<C, M>(x, first, order, proj, ctol, c, jc, r, jr))
     throw std::invalid_argument("optimize_skew: the start is not close to a method of the requested order");
-  if (c.size() >= n) throw std::invalid_argument("optimize_skew: no free parameters are left once the order conditions hold");
+  if (c.size() >= n)
+    throw std::invalid_argument("optimize_skew: no free parameters are left once the order conditions hold");
   const std::size_t k = n - c.size();
   R obj = sumsq(r);
   // |r|^2 at the restoration of x + U y (or +inf)
@@ -858,7 +864,8 @@ int skew_reduced_newton(std::vector<typename complex_ops<C>::real>& x, Flow firs
       for (std::size_t j = 0; j < n; ++j) xt[j] += R(y[i]) * u[i][j];
     std::vector<R> ct, rt;
     std::vector<std::vector<R>> jct, jrt;
-    if (!skew_restore<C, M>(xt, first, order, proj, ctol, ct, jct, rt, jrt)) return std::numeric_limits<double>::infinity();
+    if (!skew_restore<C, M>(xt, first, order, proj, ctol, ct, jct, rt, jrt))
+      return std::numeric_limits<double>::infinity();
     return static_cast<double>(sumsq(rt));
   };
   int it = 0;
@@ -990,7 +997,8 @@ SkewRun skew_run_n(std::vector<double> x, Flow first, int order, double perturba
       throw std::invalid_argument("optimize_skew: the start is not close to a method of the requested order");
     std::vector<std::size_t> free;
     std::vector<std::vector<double>> u;
-    if (!tangent_basis(jc, x.size(), free, u)) throw std::invalid_argument("optimize_skew: degenerate constraints at the start");
+    if (!tangent_basis(jc, x.size(), free, u))
+      throw std::invalid_argument("optimize_skew: degenerate constraints at the start");
     SplitMix64 g{seed};
     g.next();
     for (const auto& dir : u) {
@@ -1012,8 +1020,9 @@ std::vector<bigfloat> skew_polish_n(SkewRun& run, Flow first, int order, int max
   for (double v : run.x) xb.emplace_back(v);
   const double digits = static_cast<double>(bigfloat::default_precision());
   bool conv = false;
-  run.iterations += skew_reduced_newton<bigcomplex, M>(xb, first, order, max_iterations, std::pow(10.0, -0.45 * digits),
-                                                       std::pow(10.0, -0.8 * digits), 0, true, run.hessian, run.free, conv);
+  run.iterations +=
+      skew_reduced_newton<bigcomplex, M>(xb, first, order, max_iterations, std::pow(10.0, -0.45 * digits),
+                                         std::pow(10.0, -0.8 * digits), 0, true, run.hessian, run.free, conv);
   run.converged = conv;
   return xb;
 }
@@ -1028,8 +1037,8 @@ inline SkewRun skew_run(std::size_t m, const std::vector<double>& x, Flow first,
     NYSTROM_SKEW_SIZES(NYSTROM_CASE)
 #undef NYSTROM_CASE
     default:
-      throw std::invalid_argument("optimize_skew: the start must have an odd number of sub-steps between 5 and 17, got " +
-                                  std::to_string(m));
+      throw std::invalid_argument(
+          "optimize_skew: the start must have an odd number of sub-steps between 5 and 17, got " + std::to_string(m));
   }
 }
 inline std::vector<bigfloat> skew_polish(std::size_t m, SkewRun& run, Flow first, int order, int max_iterations) {
@@ -1091,16 +1100,19 @@ struct SkewSearchResult {
 /// `start` are used. Deterministic for a seed (independent of the number of threads).
 inline SkewSearchResult optimize_skew(const std::vector<bigcomplex>& start, Flow first, const SkewSearchOptions& opt) {
   if (opt.order < 1 || opt.order % 2 == 0 || opt.order > 9)
-    throw std::invalid_argument("optimize_skew: the order must be odd (the leading error of a skew-symmetric method is "
-                                "imaginary only for odd orders), between 1 and 9");
-  if (opt.tries < 1 || opt.tries > 100000) throw std::invalid_argument("optimize_skew: tries must be between 1 and 100000");
+    throw std::invalid_argument(
+        "optimize_skew: the order must be odd (the leading error of a skew-symmetric method is "
+        "imaginary only for odd orders), between 1 and 9");
+  if (opt.tries < 1 || opt.tries > 100000)
+    throw std::invalid_argument("optimize_skew: tries must be between 1 and 100000");
   if (!(opt.perturbation >= 0) || opt.perturbation > 10)
     throw std::invalid_argument("optimize_skew: the perturbation must be between 0 and 10");
   if (opt.polish_bits != 0 && (opt.polish_bits < 128 || opt.polish_bits > 2048))
     throw std::invalid_argument("optimize_skew: the polishing precision must be 0 or 128..2048 bits");
   if (opt.max_iterations < 1 || opt.max_iterations > 100000)
     throw std::invalid_argument("optimize_skew: max_iterations must be between 1 and 100000");
-  if (opt.threads < 1 || opt.threads > 256) throw std::invalid_argument("optimize_skew: threads must be between 1 and 256");
+  if (opt.threads < 1 || opt.threads > 256)
+    throw std::invalid_argument("optimize_skew: threads must be between 1 and 256");
   const std::size_t m = start.size();
   if (m < 5 || m > 17 || m % 2 == 0)
     throw std::invalid_argument("optimize_skew: the start must have an odd number of sub-steps between 5 and 17, got " +

@@ -128,7 +128,8 @@ class Series {
   /// log(*this) = sum_k (-1)^{k+1} Y^k / k, Y = *this - 1. Requires constant term 1 (checked for exact K).
   Series log() const {
     if constexpr (coef_traits<K>::exact()) {
-      if (!(c_[0] == from_rational<K>(mpq_class(1)))) throw std::invalid_argument("log of a series with constant term != 1");
+      if (!(c_[0] == from_rational<K>(mpq_class(1))))
+        throw std::invalid_argument("log of a series with constant term != 1");
     }
     Series y = *this;
     y.c_[0] = K{};
@@ -204,12 +205,12 @@ struct LieElement {
 class LieStructure {
  public:
   struct Degree {
-    std::vector<std::uint32_t> lyndon;             // Lyndon words of this degree, ascending
-    std::vector<std::vector<long>> tri;       // tri[i][j] = coefficient of lyndon[j] in P_{lyndon[i]}
-    std::vector<int> elements;                     // basis elements of the free algebra (indices), basis order
-    std::vector<int> kept;                         // those that form the basis of the algebra (quotient)
-    std::vector<std::vector<mpq_class>> project;   // kept x |lyndon|: coordinates from values at Lyndon words
-    std::vector<std::vector<mpq_class>> to_basis;  // |elements| x |lyndon|: free-algebra basis coordinates
+    std::vector<std::uint32_t> lyndon;                // Lyndon words of this degree, ascending
+    std::vector<std::vector<long>> tri;               // tri[i][j] = coefficient of lyndon[j] in P_{lyndon[i]}
+    std::vector<int> elements;                        // basis elements of the free algebra (indices), basis order
+    std::vector<int> kept;                            // those that form the basis of the algebra (quotient)
+    std::vector<std::vector<mpq_class>> project;      // kept x |lyndon|: coordinates from values at Lyndon words
+    std::vector<std::vector<mpq_class>> to_basis;     // |elements| x |lyndon|: free-algebra basis coordinates
     std::map<int, std::vector<mpq_class>> reduction;  // dropped element -> its class as a combination of kept
   };
 
@@ -491,10 +492,10 @@ class LieStructure {
     std::vector<std::vector<mpq_class>> rows;  // reduced ideal rows
     std::vector<int> pivot_of_row;
     if (algebra_ == AlgebraKind::rkn && d >= 4) {
-      std::vector<WordPoly> gens{poly_bracket(poly_letter(letter_V), 1,
-                                              poly_bracket(poly_letter(letter_V), 1,
-                                                           poly_bracket(poly_letter(letter_T), 1, poly_letter(letter_V), 1), 2),
-                                              3)};
+      std::vector<WordPoly> gens{poly_bracket(
+          poly_letter(letter_V), 1,
+          poly_bracket(poly_letter(letter_V), 1, poly_bracket(poly_letter(letter_T), 1, poly_letter(letter_V), 1), 2),
+          3)};
       for (int k = 4; k < d; ++k) {
         std::vector<WordPoly> more;
         for (const auto& p : gens) {
@@ -606,7 +607,8 @@ class LieProjector {
   const LieStructure& structure() const { return *s_; }
 
   std::vector<std::vector<K>> operator()(const Series<K>& z) const {
-    if (z.degree() < s_->degree()) throw std::invalid_argument("LieProjector: series of lower degree than the structure");
+    if (z.degree() < s_->degree())
+      throw std::invalid_argument("LieProjector: series of lower degree than the structure");
     std::vector<std::vector<K>> out(static_cast<std::size_t>(s_->degree()) + 1);
     for (int d = 1; d <= s_->degree(); ++d) {
       const auto& lyn = s_->at(d).lyndon;

@@ -153,14 +153,17 @@ inline MethodFile parse_method_file(const std::string& text, const std::string& 
     rest = detail::trim(rest);
     if (key == "name") {
       if (have_name) fail("'name' given twice");
-      if (!detail::valid_name(rest)) fail("the name must be one token of letters, digits and - _ . : + (at most 64), got '" + rest + "'");
+      if (!detail::valid_name(rest))
+        fail("the name must be one token of letters, digits and - _ . : + (at most 64), got '" + rest + "'");
       f.name = rest;
       have_name = true;
     } else if (key == "order") {
       if (have_order) fail("'order' given twice");
-      if (rest.empty() || rest.size() > 3 || !std::all_of(rest.begin(), rest.end(), ::isdigit)) fail("the order must be an integer, got '" + rest + "'");
+      if (rest.empty() || rest.size() > 3 || !std::all_of(rest.begin(), rest.end(), ::isdigit))
+        fail("the order must be an integer, got '" + rest + "'");
       f.order = std::stoi(rest);
-      if (f.order < 1 || f.order > max_lie_degree) fail("the order must be between 1 and " + std::to_string(max_lie_degree) + ", got " + rest);
+      if (f.order < 1 || f.order > max_lie_degree)
+        fail("the order must be between 1 and " + std::to_string(max_lie_degree) + ", got " + rest);
       have_order = true;
     } else if (key == "source") {
       if (have_source) fail("'source' given twice");
@@ -185,7 +188,8 @@ inline MethodFile parse_method_file(const std::string& text, const std::string& 
         if (dg > 0) f.min_digits = std::min(f.min_digits, dg);
       }
       if (f.steps.size() >= 10000) fail("too many sub-steps (at most 10000)");
-      f.steps.push_back({key == "drift" ? Flow::drift : Flow::kick, nums[0], nums.size() > 1 ? nums[1] : std::string()});
+      f.steps.push_back(
+          {key == "drift" ? Flow::drift : Flow::kick, nums[0], nums.size() > 1 ? nums[1] : std::string()});
     } else {
       fail("unknown keyword '" + key + "' (known: name, order, source, description, drift, kick)");
     }
@@ -224,15 +228,17 @@ inline void validate_method_file(const MethodFile& f, const std::string& where) 
       has_kick = true;
     }
   }
-  if (!has_drift || !has_kick) throw std::invalid_argument("method file " + where + ": a splitting needs at least one drift and one kick");
-  const double ed = std::abs(to_cd(sd) - std::complex<double>(1, 0)), ek = std::abs(to_cd(sk) - std::complex<double>(1, 0));
+  if (!has_drift || !has_kick)
+    throw std::invalid_argument("method file " + where + ": a splitting needs at least one drift and one kick");
+  const double ed = std::abs(to_cd(sd) - std::complex<double>(1, 0)),
+               ek = std::abs(to_cd(sk) - std::complex<double>(1, 0));
   // a file with d significant digits can sum to 1 only within about 10^-d
   const double sum_tol = f.min_digits > 0 ? std::max(1e-13, std::pow(10.0, 2 - f.min_digits)) : 1e-30;
   if (!(ed <= sum_tol) || !(ek <= sum_tol)) {
     std::ostringstream msg;
     msg.precision(17);
-    msg << "method file " << where << ": the drift coefficients sum to " << to_cd(sd) << " and the kick coefficients to "
-        << to_cd(sk) << "; both must be 1";
+    msg << "method file " << where << ": the drift coefficients sum to " << to_cd(sd)
+        << " and the kick coefficients to " << to_cd(sk) << "; both must be 1";
     throw std::invalid_argument(msg.str());
   }
   check_bch_work(s.steps.size(), f.order, "method file " + where);
@@ -247,8 +253,7 @@ inline void validate_method_file(const MethodFile& f, const std::string& where) 
     for (const auto& t : bad.terms) worst = std::max(worst, std::abs(t.value));
     std::ostringstream msg;
     msg << "method file " << where << ": declares order " << f.order << " but the degree-" << bad.degree
-        << " error terms are as large as " << worst
-        << " (";
+        << " error terms are as large as " << worst << " (";
     if (a.exact) {
       msg << "computed exactly";
     } else {
@@ -299,7 +304,8 @@ inline MethodDef method_def_from_file(const std::string& path) {
 
 /// Text of a method file for a scheme (coefficients with `digits` significant digits).
 inline std::string format_method_file(const std::string& name, int order, const std::string& source,
-                                      const std::string& description, const SplittingScheme<bigcomplex>& s, int digits) {
+                                      const std::string& description, const SplittingScheme<bigcomplex>& s,
+                                      int digits) {
   if (!detail::valid_name(name)) throw std::invalid_argument("invalid method name '" + name + "'");
   std::ostringstream o;
   o << "# nystrom splitting method: sub-steps in time order, `drift|kick RE [IM]` (see analysis/method_file.hpp)\n";

@@ -163,7 +163,8 @@ inline std::shared_ptr<const Forest> forest(int max_order) {
 inline std::vector<SnTree> sn_trees(int max_order) {
   const auto f = sn_detail::forest(max_order);
   if (max_order == 0) return {};
-  return {f->trees.begin(), f->trees.begin() + static_cast<std::ptrdiff_t>(f->first[static_cast<std::size_t>(max_order)])};
+  return {f->trees.begin(),
+          f->trees.begin() + static_cast<std::ptrdiff_t>(f->first[static_cast<std::size_t>(max_order)])};
 }
 
 /// Number of SN-trees with rho = n (n >= 1).
@@ -255,7 +256,8 @@ inline std::vector<RknConditionInfo> rkn_conditions_of_order(int n) {
   std::vector<RknConditionInfo> out;
   auto add = [&](int rho, RknWeight w) {
     if (rho < 1) return;
-    for (std::size_t k = f->first[static_cast<std::size_t>(rho - 1)]; k < f->first[static_cast<std::size_t>(rho)]; ++k) {
+    for (std::size_t k = f->first[static_cast<std::size_t>(rho - 1)]; k < f->first[static_cast<std::size_t>(rho)];
+         ++k) {
       const SnTree& t = f->trees[k];
       RknConditionInfo c;
       c.tree = static_cast<int>(k);

@@ -19,7 +19,8 @@
 namespace nystrom {
 
 // Expression templates off: values convert implicitly and read like ordinary arithmetic.
-using bigfloat = boost::multiprecision::number<boost::multiprecision::mpfr_float_backend<0>, boost::multiprecision::et_off>;
+using bigfloat =
+    boost::multiprecision::number<boost::multiprecision::mpfr_float_backend<0>, boost::multiprecision::et_off>;
 
 struct bigcomplex {
   bigfloat re{0};
@@ -43,7 +44,9 @@ struct bigcomplex {
 };
 
 /// Bits of the reference precision used to build coefficients for a working type of `bits`.
-inline unsigned reference_bits(long working_bits) { return static_cast<unsigned>(std::max<long>(256, working_bits + 64)); }
+inline unsigned reference_bits(long working_bits) {
+  return static_cast<unsigned>(std::max<long>(256, working_bits + 64));
+}
 
 /// Sets the MPFR default precision of bigfloat (in bits) for the lifetime of the guard.
 ///
@@ -51,10 +54,11 @@ inline unsigned reference_bits(long working_bits) { return static_cast<unsigned>
 /// mpfr_float_backend<0>, atomic but not thread_local), and every bigfloat created or computed reads it.
 /// Two threads building coefficients at different precisions would race on it (a race of logic, not a data
 /// race, so ThreadSanitizer is silent about it): one thread's coefficients could be rounded at the other's
-/// precision, and interleaved save/restore pairs could leave the wrong default behind. The guard therefore also holds a process-wide recursive mutex for its lifetime: a guard in
-/// another thread waits until this one ends, and guards nested in one thread nest as before. Coefficients
-/// are built once per integrator, outside the hot loop, so serialising their construction costs no speed
-/// where it matters. In a multi-threaded program, compute with bigfloat only inside a guard.
+/// precision, and interleaved save/restore pairs could leave the wrong default behind. The guard therefore also holds a
+/// process-wide recursive mutex for its lifetime: a guard in another thread waits until this one ends, and guards
+/// nested in one thread nest as before. Coefficients are built once per integrator, outside the hot loop, so
+/// serialising their construction costs no speed where it matters. In a multi-threaded program, compute with bigfloat
+/// only inside a guard.
 class BigPrecision {
  public:
   explicit BigPrecision(unsigned bits) : lock_(mutex()), saved_(bigfloat::default_precision()) {

@@ -142,17 +142,17 @@ NYSTROM_QD_FORCE_INLINE inline double dd_two_prod(double a, double b, double& er
 #endif
 }
 
-#define NYSTROM_QD_ADD_SUB(ATTR)                                       \
-  ATTR static B add(const B& a, const B& b) { return a + b; }          \
-  ATTR static B add(const B& a, double b) { return a + b; }            \
-  ATTR static B add(double a, const B& b) { return a + b; }            \
-  ATTR static B sub(const B& a, const B& b) { return a - b; }          \
-  ATTR static B sub(const B& a, double b) { return a - b; }            \
-  ATTR static B sub(double a, const B& b) { return a - b; }            \
-  ATTR static B neg(const B& a) { return -a; }                         \
-  ATTR static void add_to(B& a, const B& b) { a += b; }                \
-  ATTR static void add_to(B& a, double b) { a += b; }                  \
-  ATTR static void sub_from(B& a, const B& b) { a -= b; }              \
+#define NYSTROM_QD_ADD_SUB(ATTR)                              \
+  ATTR static B add(const B& a, const B& b) { return a + b; } \
+  ATTR static B add(const B& a, double b) { return a + b; }   \
+  ATTR static B add(double a, const B& b) { return a + b; }   \
+  ATTR static B sub(const B& a, const B& b) { return a - b; } \
+  ATTR static B sub(const B& a, double b) { return a - b; }   \
+  ATTR static B sub(double a, const B& b) { return a - b; }   \
+  ATTR static B neg(const B& a) { return -a; }                \
+  ATTR static void add_to(B& a, const B& b) { a += b; }       \
+  ATTR static void add_to(B& a, double b) { a += b; }         \
+  ATTR static void sub_from(B& a, const B& b) { a -= b; }     \
   ATTR static void sub_from(B& a, double b) { a -= b; }
 
 /// libqd's addition, subtraction and multiplication of B (see above).
@@ -216,8 +216,8 @@ struct qd_number : B {
   qd_number() = default;
   qd_number(const B& v) : B(v) {}  // NOLINT: implicit, results of libqd functions
   template <std::integral I>
-    requires(!std::same_as<I, int> && !std::same_as<I, bool>)
-  qd_number(I v) : B(0.0) {  // NOLINT: implicit like the int constructor
+  requires(!std::same_as<I, int> && !std::same_as<I, bool>) qd_number(I v)
+      : B(0.0) {  // NOLINT: implicit like the int constructor
     detail::split_integer(v, this->x[0], this->x[1]);
   }
 
@@ -239,19 +239,43 @@ struct qd_number : B {
 
   using arith = detail::qd_arith<B>;
   NYSTROM_QD_FORCE_INLINE qd_number operator-() const { return arith::neg(base()); }
-  NYSTROM_QD_FORCE_INLINE qd_number& operator+=(const qd_number& o) { arith::add_to(*this, o.base()); return *this; }
-  NYSTROM_QD_FORCE_INLINE qd_number& operator-=(const qd_number& o) { arith::sub_from(*this, o.base()); return *this; }
-  NYSTROM_QD_FORCE_INLINE qd_number& operator*=(const qd_number& o) { arith::mul_by(*this, o.base()); return *this; }
-  qd_number& operator/=(const qd_number& o) { B::operator/=(o.base()); return *this; }
-  NYSTROM_QD_FORCE_INLINE qd_number& operator+=(double o) { arith::add_to(*this, o); return *this; }
-  NYSTROM_QD_FORCE_INLINE qd_number& operator-=(double o) { arith::sub_from(*this, o); return *this; }
-  NYSTROM_QD_FORCE_INLINE qd_number& operator*=(double o) { arith::mul_by(*this, o); return *this; }
-  qd_number& operator/=(double o) { B::operator/=(o); return *this; }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator+=(const qd_number& o) {
+    arith::add_to(*this, o.base());
+    return *this;
+  }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator-=(const qd_number& o) {
+    arith::sub_from(*this, o.base());
+    return *this;
+  }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator*=(const qd_number& o) {
+    arith::mul_by(*this, o.base());
+    return *this;
+  }
+  qd_number& operator/=(const qd_number& o) {
+    B::operator/=(o.base());
+    return *this;
+  }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator+=(double o) {
+    arith::add_to(*this, o);
+    return *this;
+  }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator-=(double o) {
+    arith::sub_from(*this, o);
+    return *this;
+  }
+  NYSTROM_QD_FORCE_INLINE qd_number& operator*=(double o) {
+    arith::mul_by(*this, o);
+    return *this;
+  }
+  qd_number& operator/=(double o) {
+    B::operator/=(o);
+    return *this;
+  }
 
-#define NYSTROM_QD_BINARY(op, f)                                                                                    \
-  [[gnu::always_inline]] friend qd_number operator op(const qd_number& a, const qd_number& b) {                     \
-    return arith::f(a.base(), b.base());                                                                           \
-  }                                                                                                                \
+#define NYSTROM_QD_BINARY(op, f)                                                                                      \
+  [[gnu::always_inline]] friend qd_number operator op(const qd_number& a, const qd_number& b) {                       \
+    return arith::f(a.base(), b.base());                                                                              \
+  }                                                                                                                   \
   [[gnu::always_inline]] friend qd_number operator op(const qd_number& a, double b) { return arith::f(a.base(), b); } \
   [[gnu::always_inline]] friend qd_number operator op(double a, const qd_number& b) { return arith::f(a, b.base()); }
   NYSTROM_QD_BINARY(+, add)
@@ -342,7 +366,8 @@ NYSTROM_QD_FORCE_INLINE inline InvSqrtSeed inv_sqrt_seed(double a, double b) {
 /// r2^(-3/2) in double-double without division or square root of double-doubles (see above).
 NYSTROM_QD_FORCE_INLINE inline double_double inv_r3(const double_double& r2) {
   const double a = r2.x[0], b = r2.x[1];
-  if (!detail::inv_r3_in_range(a)) [[unlikely]] return detail::inv_r3_generic(r2);
+  if (!detail::inv_r3_in_range(a)) [[unlikely]]
+    return detail::inv_r3_generic(r2);
   const auto [y, p, p_lo, e, e_lo] = detail::inv_sqrt_seed(a, b);
   double z_lo, w_lo, h1_lo, h2_lo, lo_out;
   const double z = detail::dd_two_prod(p, y, z_lo);  // y^3 = z + t to about 2^-106
@@ -359,7 +384,8 @@ NYSTROM_QD_FORCE_INLINE inline double_double inv_r3(const double_double& r2) {
 /// r2^(-3/2) in quad-double: the double-double r2^(-1/2) as seed, one correction in quad-double.
 inline quad_double inv_r3(const quad_double& r2) {
   const double a = r2.x[0];
-  if (!detail::inv_r3_in_range(a)) [[unlikely]] return detail::inv_r3_generic(r2);
+  if (!detail::inv_r3_in_range(a)) [[unlikely]]
+    return detail::inv_r3_generic(r2);
   // y = r2^(-1/2) (1 + e0/2 + 3/8 e0^2) as a double-double, to about 2^-104
   const auto [y0, p, p_lo, e0, e0_lo] = detail::inv_sqrt_seed(a, r2.x[1]);
   double y_lo;
@@ -370,7 +396,7 @@ inline quad_double inv_r3(const quad_double& r2) {
   const ::dd_real e(d.x[0], d.x[1]);          // to about 2^-210 absolute
   const ::dd_real c = e * (1.5 + 1.875 * e);  // (1 - e)^(-3/2) - 1 (e^3 below 2^-300)
   // (libqd 2.3's qd_real * dd_real misses the product a[3] b_hi: quad-double products only)
-  const ::qd_real z = y2 * y;                 // y^3
+  const ::qd_real z = y2 * y;  // y^3
   return z + z * ::qd_real(c.x[0], c.x[1], 0.0, 0.0);
 }
 
@@ -431,7 +457,8 @@ class MpfrPrecision {
 
 /// Parses the BITS of "mpfr:BITS" (the text after the colon). Throws std::invalid_argument.
 inline long parse_mpfr_bits(const std::string& text) {
-  const std::string what = "malformed MPFR precision 'mpfr:" + text + "': expected mpfr:BITS with BITS a whole number between " +
+  const std::string what = "malformed MPFR precision 'mpfr:" + text +
+                           "': expected mpfr:BITS with BITS a whole number between " +
                            std::to_string(MpfrPrecision::min_bits) + " and " + std::to_string(MpfrPrecision::max_bits);
   if (text.empty() || text.size() > 9) throw std::invalid_argument(what);
   for (char c : text)

@@ -23,7 +23,9 @@ struct type_tag {
 };
 
 /// Names accepted by dispatch_precision (mpfr:BITS with BITS a number of bits).
-inline std::vector<std::string> precision_names() { return {"double", "long-double", "float128", "dd", "qd", "mpfr:BITS"}; }
+inline std::vector<std::string> precision_names() {
+  return {"double", "long-double", "float128", "dd", "qd", "mpfr:BITS"};
+}
 
 /// Calls fn(type_tag<T>{}) with the scalar type named by `name`. Throws std::invalid_argument.
 /// Aliases: "long double"/"ld", "quad"/"quadruple"/"__float128", "double-double", "quad-double".
@@ -39,8 +41,7 @@ decltype(auto) dispatch_precision(const std::string& name, Fn&& fn) {
     const MpfrPrecision scope(parse_mpfr_bits(name.substr(5)));
     return fn(type_tag<mpfr_real>{});
   }
-  if (name == "mpfr")
-    throw std::invalid_argument("precision 'mpfr' needs a number of bits: mpfr:BITS, e.g. mpfr:256");
+  if (name == "mpfr") throw std::invalid_argument("precision 'mpfr' needs a number of bits: mpfr:BITS, e.g. mpfr:256");
   std::string known;
   for (const auto& n : precision_names()) known += (known.empty() ? "" : ", ") + n;
   throw std::invalid_argument("unknown precision '" + name + "' (known: " + known + ")");

@@ -17,7 +17,8 @@ namespace nystrom {
 template <class T>
 T quantile_inplace(std::vector<T>& x, double p) {
   if (x.empty()) throw std::invalid_argument("quantile of an empty sample");
-  if (!(p >= 0.0 && p <= 1.0)) throw std::invalid_argument("quantile level must lie in [0, 1], got " + std::to_string(p));
+  if (!(p >= 0.0 && p <= 1.0))
+    throw std::invalid_argument("quantile level must lie in [0, 1], got " + std::to_string(p));
   for (const auto& v : x) {
     using std::isnan;
     if (isnan(v)) throw std::invalid_argument("quantile of a sample containing NaN");

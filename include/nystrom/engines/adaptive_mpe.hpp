@@ -113,7 +113,8 @@ class AdaptiveMpeIntegrator {
   /// k: the sequence (>= 2 members); c: its coefficients (order 2n) and d = c - chat (the error
   /// combination), in the working type; base: the symmetric second-order T_2.
   AdaptiveMpeIntegrator(std::vector<long> k, std::vector<scalar_type> c, std::vector<scalar_type> d,
-                        SplittingScheme<scalar_type> base, Force force, AdaptiveOptions opt = {}, EngineOptions eopt = {})
+                        SplittingScheme<scalar_type> base, Force force, AdaptiveOptions opt = {},
+                        EngineOptions eopt = {})
       : opt_(opt),
         eopt_(eopt),
         k_(std::move(k)),
@@ -134,7 +135,8 @@ class AdaptiveMpeIntegrator {
       throw std::invalid_argument("tolerance " + sci(opt_.tol) + " is below what " + scalar_traits<real_type>::name() +
                                   " resolves (10 eps = " + sci(min_tol) + "); use a wider precision");
     if (eopt_.mpe_schedule == MpeSchedule::concurrent)
-      throw std::invalid_argument("adaptive MPE: the concurrent schedule is not available (use lockstep or sequential)");
+      throw std::invalid_argument(
+          "adaptive MPE: the concurrent schedule is not available (use lockstep or sequential)");
     method_order_ = 2 * static_cast<int>(k_.size());
     if (opt_.error_order == 0) opt_.error_order = method_order_ - 2;
     ref_ = static_cast<std::size_t>(std::max_element(k_.begin(), k_.end()) - k_.begin());
@@ -252,8 +254,8 @@ class AdaptiveMpeIntegrator {
   // vectors) or a std::integral_constant (local arrays, unrolled). The same operations in lockstep
   // and in sequence (advance_lockstep is bitwise advance_scaled product after product).
   template <bool Comp, class Count, class XS, class AS, class CS>
-  NYSTROM_ALWAYS_INLINE void trial(Count P, const State<V>& s, const V& a0, XS& x, AS& a, CS& cq, CS& cv,
-                                   State<V>& inc, State<V>& err) {
+  NYSTROM_ALWAYS_INLINE void trial(Count P, const State<V>& s, const V& a0, XS& x, AS& a, CS& cq, CS& cv, State<V>& inc,
+                                   State<V>& err) {
     using SS = SplittingStepper<V, Force>;
     const std::size_t n = s.q.size();
     SS::for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
@@ -607,8 +609,8 @@ class AdaptiveMpeIntegrator {
     while (t < t1) {
       if (accepted + rejected >= opt_.max_steps) {
         store();
-        throw TooManySteps("adaptive MPE: more than " + std::to_string(opt_.max_steps) + " steps before reaching t1 = " +
-                           sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
+        throw TooManySteps("adaptive MPE: more than " + std::to_string(opt_.max_steps) +
+                           " steps before reaching t1 = " + sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
       }
       h = h_want;
       bool last = false;
@@ -657,7 +659,8 @@ class AdaptiveMpeIntegrator {
         t = last ? t1 : t + h;
         ++accepted;
         last_h = as_double(h);
-        const bool stop = adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
+        const bool stop =
+            adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
         const double fac = ctl.accepted(std::pow(e2, expo), as_double(h), last_rejected);
         const real_type hn = std::min(h * real_type(fac), hmax);
         h_next_ = last && h < h_want ? h_want : hn;  // a step shortened to land on t1 keeps the proposal

@@ -51,8 +51,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstddef>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -71,15 +71,15 @@
 namespace nystrom {
 
 struct AdaptiveOptions {
-  double tol = 1e-10;      // absolute and relative tolerance (see the norm above)
-  double safety = 0.9;     // safety factor on the optimal step (see below)
-  double fac_min = 0.2;    // smallest step ratio per step
-  double fac_max = 4.0;    // largest step ratio per step
-  double h0 = 0.0;         // first step; 0: automatic
-  double h_max = 0.0;      // largest step; 0: |t1 - t0|
+  double tol = 1e-10;         // absolute and relative tolerance (see the norm above)
+  double safety = 0.9;        // safety factor on the optimal step (see below)
+  double fac_min = 0.2;       // smallest step ratio per step
+  double fac_max = 4.0;       // largest step ratio per step
+  double h0 = 0.0;            // first step; 0: automatic
+  double h_max = 0.0;         // largest step; 0: |t1 - t0|
   long max_steps = 10000000;  // accepted + rejected steps per integrate_to call
-  int error_order = 0;     // p, the lower order of the pair; 0: determined from the tableau
-  bool predictive = true;  // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
+  int error_order = 0;        // p, the lower order of the pair; 0: determined from the tableau
+  bool predictive = true;     // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
 
   void validate() const {
     if (!std::isfinite(tol) || !(tol > 0)) throw std::invalid_argument("tolerance must be a positive finite number");
@@ -305,13 +305,13 @@ class AdaptiveRknIntegrator {
     const double expo = -1.0 / (opt_.error_order + 1);
     const real_type tiny = real_type(16) * eps * std::max(abs(t0), abs(t1));
     real_type t = t0;
-    real_type h_want = h;  // the controller's proposal for the next step
+    real_type h_want = h;      // the controller's proposal for the next step
     bool error_finite = true;  // the last error estimate was finite (else the force returned NaN or inf)
     State<V> y = s, err;
     while (t < t1) {
       if (st.accepted + st.rejected >= opt_.max_steps)
-        throw TooManySteps("adaptive RKN: more than " + std::to_string(opt_.max_steps) + " steps before reaching t1 = " +
-                           sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
+        throw TooManySteps("adaptive RKN: more than " + std::to_string(opt_.max_steps) +
+                           " steps before reaching t1 = " + sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
       h = h_want;
       bool last = false;
       if (t + h * real_type(1.01) >= t1) {
@@ -332,7 +332,8 @@ class AdaptiveRknIntegrator {
         t = last ? t1 : t + h;
         ++st.accepted;
         st.last_h = as_double(h);
-        const bool stop = adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
+        const bool stop =
+            adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
         const double fac = ctl.accepted(std::pow(e, expo), as_double(h), last_rejected);
         // After a step shortened to land on t1, keep the earlier proposal for the next call.
         h_next_ = last && h < h_want ? h_want : std::min(h * real_type(fac), hmax);

@@ -59,12 +59,8 @@ inline std::vector<long> gbs_sequence(GbsSequence seq, int kmax) {
   std::vector<long> n;
   for (int j = 1; j <= kmax; ++j) {
     switch (seq) {
-      case GbsSequence::harmonic:
-        n.push_back(2L * j);
-        break;
-      case GbsSequence::romberg:
-        n.push_back(2L << (j - 1));
-        break;
+      case GbsSequence::harmonic: n.push_back(2L * j); break;
+      case GbsSequence::romberg: n.push_back(2L << (j - 1)); break;
       case GbsSequence::bulirsch:
         n.push_back(j <= 3 ? 2L * j : 2 * n[static_cast<std::size_t>(j) - 3]);  // 2,4,6,8,12,16,24,...
         break;
@@ -78,7 +74,7 @@ struct GbsOptions {
   double atol = 1e-12;
   int max_columns = 12;  // kmax: columns of the extrapolation table (order up to 2 kmax)
   GbsSequence sequence = GbsSequence::harmonic;
-  double initial_step = 0;   // 0: the first call's span
+  double initial_step = 0;    // 0: the first call's span
   long max_steps = 10000000;  // per integrate_to call, accepted and rejected
 };
 
@@ -103,9 +99,11 @@ class GbsIntegrator {
     const double floor = 20 * eps;
     if ((opt_.rtol > 0 && opt_.rtol < floor) || (opt_.atol > 0 && opt_.atol < floor) ||
         std::max(opt_.rtol, opt_.atol) < floor)
-      throw std::invalid_argument("GBS: tolerance " + detail::fmt_g(std::min(opt_.rtol > 0 ? opt_.rtol : 1.0, opt_.atol > 0 ? opt_.atol : 1.0)) +
-                                  " is below what " + scalar_traits<real_type>::name() + " can reach (>= " + detail::fmt_g(floor) +
-                                  "; use a wider --precision)");
+      throw std::invalid_argument(
+          "GBS: tolerance " +
+          detail::fmt_g(std::min(opt_.rtol > 0 ? opt_.rtol : 1.0, opt_.atol > 0 ? opt_.atol : 1.0)) +
+          " is below what " + scalar_traits<real_type>::name() + " can reach (>= " + detail::fmt_g(floor) +
+          "; use a wider --precision)");
     if (!(opt_.initial_step >= 0) || !std::isfinite(opt_.initial_step))
       throw std::invalid_argument("GBS: the initial step must be finite and >= 0");
     if (opt_.max_steps <= 0) throw std::invalid_argument("GBS: max_steps must be positive");
@@ -117,7 +115,8 @@ class GbsIntegrator {
     H_ = static_cast<real_type>(opt_.initial_step);
     A_.resize(static_cast<std::size_t>(km) + 1);
     A_[1] = nseq_[0] + 1;
-    for (int j = 2; j <= km; ++j) A_[static_cast<std::size_t>(j)] = A_[static_cast<std::size_t>(j) - 1] + nseq_[static_cast<std::size_t>(j) - 1];
+    for (int j = 2; j <= km; ++j)
+      A_[static_cast<std::size_t>(j)] = A_[static_cast<std::size_t>(j) - 1] + nseq_[static_cast<std::size_t>(j) - 1];
     row_.resize(static_cast<std::size_t>(km));
     prev_.resize(static_cast<std::size_t>(km));
   }
@@ -154,7 +153,8 @@ class GbsIntegrator {
   template <class Obs = NoObserver>
   void integrate_to(State<V>& s, real_type span, Obs&& obs = {}) {
     using std::abs;
-    if (!(span > real_type(0)) || !is_finite_scalar(span)) throw std::invalid_argument("GBS: the time span must be positive");
+    if (!(span > real_type(0)) || !is_finite_scalar(span))
+      throw std::invalid_argument("GBS: the time span must be positive");
     real_type t(0);
     if (!(H_ > real_type(0))) H_ = span;
     long tries = 0;
@@ -169,21 +169,23 @@ class GbsIntegrator {
     while (t < span) {
       if (++tries > opt_.max_steps)
         throw too_many_steps("GBS: more than " + std::to_string(opt_.max_steps) + " steps for one span (t = " +
-                                    detail::fmt_g(as_double(t)) + " of " + detail::fmt_g(as_double(span)) + ")");
+                             detail::fmt_g(as_double(t)) + " of " + detail::fmt_g(as_double(span)) + ")");
       const real_type rem = span - t;
       const bool final_step = H_ >= rem * real_type(0.999999);  // avoid a sliver of a last step
       const real_type H = final_step ? rem : H_;
       if (!(H > abs(span) * real_type(1e-3) * epsilon_of<real_type>()) && !final_step)
         throw step_size_underflow("GBS: step size underflow at t = " + detail::fmt_g(as_double(t)) +
-                                    " (singular force, or a tolerance the precision cannot reach)");
+                                  " (singular force, or a tolerance the precision cannot reach)");
       real_type Hnew;
       if (try_step(s, H, last_rejected, Hnew)) {
         t = final_step ? span : t + H;
         ++accepted_;
         last_rejected = false;
         // keep the controller's step unless this was a shortened final step that is smaller than it
-        if (!final_step || Hnew < H_ || H >= H_) H_ = Hnew;
-        else H_ = std::max(H_, Hnew);
+        if (!final_step || Hnew < H_ || H >= H_)
+          H_ = Hnew;
+        else
+          H_ = std::max(H_, Hnew);
         bool stop = false;
         if constexpr (std::is_same_v<std::invoke_result_t<Obs&, const real_type&, const State<V>&>, bool>)
           stop = obs(static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
@@ -272,8 +274,8 @@ class GbsIntegrator {
     resize_like(f0_, s.q);
     force_(s.q, f0_);
     ++evals_;
-    std::vector<real_type> Hj(static_cast<std::size_t>(km) + 1, H), W(static_cast<std::size_t>(km) + 1,
-                                                                    std::numeric_limits<real_type>::max());
+    std::vector<real_type> Hj(static_cast<std::size_t>(km) + 1, H),
+        W(static_cast<std::size_t>(km) + 1, std::numeric_limits<real_type>::max());
     const int k = k_;
     const std::size_t dim = s.q.size();
     for (int j = 1; j <= std::min(k + 1, km); ++j) {

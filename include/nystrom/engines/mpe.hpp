@@ -17,8 +17,8 @@
 
 #include <algorithm>
 #include <array>
-#include <exception>
 #include <cstddef>
+#include <exception>
 #include <numeric>
 #include <set>
 #include <sstream>
@@ -148,7 +148,10 @@ class MpeStepper {
   /// k: the sequence; c: its coefficients in the working type; base: T_2 as a splitting scheme.
   MpeStepper(std::vector<long> k, std::vector<scalar_type> c, SplittingScheme<scalar_type> base, Force force,
              EngineOptions opt = {})
-      : k_(std::move(k)), c_(std::move(c)), base_(std::move(base), std::move(force), EngineOptions{true, Compensation::off}), opt_(opt) {
+      : k_(std::move(k)),
+        c_(std::move(c)),
+        base_(std::move(base), std::move(force), EngineOptions{true, Compensation::off}),
+        opt_(opt) {
     validate_mpe_sequence(k_);
     if (c_.size() != k_.size()) throw std::invalid_argument("MPE: one coefficient per sequence member is needed");
     ref_ = static_cast<std::size_t>(std::max_element(k_.begin(), k_.end()) - k_.begin());
@@ -391,7 +394,8 @@ class MpeStepper {
 
   template <class Count, class TS, class CS>
   NYSTROM_ALWAYS_INLINE static void to_increments(Count P, const State<V>& s, TS& T, const CS& cq, const CS& cv) {
-    SplittingStepper<V, Force>::for_each_run(P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE { to_increment(s, T[r], cq[r], cv[r]); });
+    SplittingStepper<V, Force>::for_each_run(
+        P, [&](std::size_t r) NYSTROM_ALWAYS_INLINE { to_increment(s, T[r], cq[r], cv[r]); });
   }
 
   // s <- T_ref + sum_{i != ref} c_i (T_i - T_ref) (T: end states), or with Comp s += the same
@@ -516,12 +520,12 @@ class MpeStepper {
   long extra_evals_ = 0;
   V a0_{}, a_{};
   State<V> ti_{}, acc_{}, tref_{};
-  std::vector<State<V>> products_;        // T_2^k_i(h / k_i) of the current step (or its increment)
+  std::vector<State<V>> products_;  // T_2^k_i(h / k_i) of the current step (or its increment)
   bool lockstep_ = false, concurrent_ = false;
   std::vector<SplittingStepper<V, Force>> workers_;  // concurrent: a copy of the base per product
   std::vector<std::size_t> order_;                   // concurrent: products by decreasing k
-  std::vector<V> pa_, pcq_, pcv_;  // lockstep: each product's force cache and carries
-  std::vector<scalar_type> scaled_, hc_;  // base coefficients times h / k_i, product after product
+  std::vector<V> pa_, pcq_, pcv_;                    // lockstep: each product's force cache and carries
+  std::vector<scalar_type> scaled_, hc_;             // base coefficients times h / k_i, product after product
   Compensator<V> comp_, pc_;
 };
 

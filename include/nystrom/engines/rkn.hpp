@@ -35,8 +35,7 @@ struct RknTableau {
   void validate() const {
     const std::size_t s = c.size();
     if (s == 0) throw std::invalid_argument("RKN tableau has no stages");
-    if (a.size() != s || b.size() != s || B.size() != s)
-      throw std::invalid_argument("RKN tableau: inconsistent sizes");
+    if (a.size() != s || b.size() != s || B.size() != s) throw std::invalid_argument("RKN tableau: inconsistent sizes");
     for (std::size_t i = 0; i < s; ++i) {
       if (a[i].size() != s) throw std::invalid_argument("RKN tableau: a is not square");
       for (std::size_t j = i; j < s; ++j)

@@ -307,13 +307,15 @@ class SplittingStepper {
         force_(y.q, a[r]);
         ++evals;
         if constexpr (Comp) {
-          for (std::size_t j = 0; j < y.v.size(); ++j) compensated_add(y.v[j], cv[r][j], scalar_type(c[m - 1] * a[r][j]));
+          for (std::size_t j = 0; j < y.v.size(); ++j)
+            compensated_add(y.v[j], cv[r][j], scalar_type(c[m - 1] * a[r][j]));
         } else {
           axpy(y.v, c[m - 1], a[r]);
         }
       } else {
         if constexpr (Comp) {
-          for (std::size_t j = 0; j < y.q.size(); ++j) compensated_add(y.q[j], cq[r][j], scalar_type(c[m - 1] * y.v[j]));
+          for (std::size_t j = 0; j < y.q.size(); ++j)
+            compensated_add(y.q[j], cq[r][j], scalar_type(c[m - 1] * y.v[j]));
         } else {
           axpy(y.q, c[m - 1], y.v);
         }

@@ -19,10 +19,10 @@
 #pragma once
 
 #include <chrono>
-#include <ctime>
 #include <cmath>
 #include <complex>
 #include <cstdint>
+#include <ctime>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -44,10 +44,10 @@ struct NBodySetup {
   std::string problem = "nbody";  // nbody | twobody
   std::size_t n = 400;            // Plummer particles (nbody without a file)
   std::uint64_t seed = 42;
-  std::string ic_file;     // particle file instead of a Plummer sphere
-  double ecc = 0.2;        // twobody
-  double eps2 = -1;        // < 0: (1/N)^2 for nbody, 0 for twobody
-  int threads = 0;         // force threads (0: OpenMP default)
+  std::string ic_file;  // particle file instead of a Plummer sphere
+  double ecc = 0.2;     // twobody
+  double eps2 = -1;     // < 0: (1/N)^2 for nbody, 0 for twobody
+  int threads = 0;      // force threads (0: OpenMP default)
 };
 
 struct NBodyInstance {
@@ -104,11 +104,11 @@ class NBodyMethodStepper {
 
 struct LocalErrConfig {
   NBodySetup setup;
-  double duration = -1;        // < 0: 50 periods (twobody) or 1 time unit (nbody); in periods for twobody
-  std::vector<double> hs;      // step sizes (periods for twobody, time units for nbody)
+  double duration = -1;    // < 0: 50 periods (twobody) or 1 time unit (nbody); in periods for twobody
+  std::vector<double> hs;  // step sizes (periods for twobody, time units for nbody)
   std::vector<std::string> methods;
   std::vector<MethodDef> method_defs;  // further methods given as data (after `methods`)
-  double tol = 1e-14;          // GBS rtol = atol
+  double tol = 1e-14;                  // GBS rtol = atol
   int gbs_columns = 12;
   GbsSequence sequence = GbsSequence::harmonic;
 };

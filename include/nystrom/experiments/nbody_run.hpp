@@ -20,15 +20,15 @@ struct NBodyRunResult {
   long steps = 0;
   long force_evals = 0;
   double h = 0;
-  double energy_error = 0;     // |E - E0| / |E0|
-  double position_error = 0;   // max over components of |q - q_ref|
+  double energy_error = 0;    // |E - E0| / |E0|
+  double position_error = 0;  // max over components of |q - q_ref|
   double seconds = 0;
-  std::string reference;       // what position_error compares with
+  std::string reference;  // what position_error compares with
 };
 
 /// `method` is a catalog specification or "GBS" (then `tol` is its tolerance). h is in time units.
-inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& setup, double h, long steps, double tol = 0,
-                                double ref_tol = 1e-13) {
+inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& setup, double h, long steps,
+                                double tol = 0, double ref_tol = 1e-13) {
   if (!(h > 0) || !std::isfinite(h)) throw std::invalid_argument("the step size must be positive");
   if (steps <= 0 || steps > 100000000) throw std::invalid_argument("the number of steps must be between 1 and 1e8");
   const NBodyInstance inst = make_nbody_instance(setup);
@@ -65,7 +65,8 @@ inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& set
     GbsIntegrator<std::vector<double>, NBodyForce<double>> g(inst.force, o);
     auto ref = inst.particles.s;
     g.integrate_to(ref, h * static_cast<double>(steps));
-    for (std::size_t i = 0; i < s.q.size(); ++i) r.position_error = std::max(r.position_error, std::abs(s.q[i] - ref.q[i]));
+    for (std::size_t i = 0; i < s.q.size(); ++i)
+      r.position_error = std::max(r.position_error, std::abs(s.q[i] - ref.q[i]));
     r.reference = "GBS, tol " + std::to_string(ref_tol);
   }
   return r;

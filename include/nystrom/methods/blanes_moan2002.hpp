@@ -53,13 +53,23 @@ inline SplittingScheme<bigcomplex> blanes_moan_srkn14a() {
 inline std::vector<MethodDef> blanes_moan2002() {
   const std::string src = "Blanes & Moan, J. Comput. Appl. Math. 142 (2002) 313";
   std::vector<MethodDef> m;
-  m.push_back({{.name = "RKNb6", .family = "splitting", .order = 4, .symmetric = true, .symplectic = true,
-                .published_digits = 15, .source = src + ", SRKN6b",
+  m.push_back({{.name = "RKNb6",
+                .family = "splitting",
+                .order = 4,
+                .symmetric = true,
+                .symplectic = true,
+                .published_digits = 15,
+                .source = src + ", SRKN6b",
                 .description = "Blanes-Moan optimized 4th-order RKN splitting, 6 forces, kick first",
                 .aliases = {"SRKN6b", "BM4"}},
                [] { return MethodData{blanes_moan_srkn6b()}; }});
-  m.push_back({{.name = "RKNa14", .family = "splitting", .order = 6, .symmetric = true, .symplectic = true,
-                .published_digits = 15, .source = src + ", SRKN14a",
+  m.push_back({{.name = "RKNa14",
+                .family = "splitting",
+                .order = 6,
+                .symmetric = true,
+                .symplectic = true,
+                .published_digits = 15,
+                .source = src + ", SRKN14a",
                 .description = "Blanes-Moan optimized 6th-order RKN splitting, 14 forces, drift first",
                 .aliases = {"SRKN14a", "BM6"}},
                [] { return MethodData{blanes_moan_srkn14a()}; }});

@@ -111,11 +111,15 @@ inline std::string base_label(const std::string& base) {
 inline MethodDef triple_jump_method(int order, const std::string& base, std::string name) {
   detail::check_composition_order(order, max_triple_jump_order, "triple-jump");
   (void)leapfrog_base(base);  // validates the base name
-  MethodInfo info{.name = std::move(name), .family = "composition", .order = order, .symmetric = true,
-                  .symplectic = true, .source = "Yoshida, Phys. Lett. A 150 (1990) 262 (triple jump)",
-                  .description = "Yoshida triple jump of order " + std::to_string(order) + " on the " +
-                                 detail::base_label(base),
-                  .aliases = {}};
+  MethodInfo info{
+      .name = std::move(name),
+      .family = "composition",
+      .order = order,
+      .symmetric = true,
+      .symplectic = true,
+      .source = "Yoshida, Phys. Lett. A 150 (1990) 262 (triple jump)",
+      .description = "Yoshida triple jump of order " + std::to_string(order) + " on the " + detail::base_label(base),
+      .aliases = {}};
   return {info, [order, base] { return MethodData{compose(leapfrog_base(base), triple_jump_weights(order))}; }};
 }
 
@@ -123,8 +127,12 @@ inline MethodDef triple_jump_method(int order, const std::string& base, std::str
 inline MethodDef suzuki_method(int order, const std::string& base, std::string name) {
   detail::check_composition_order(order, max_suzuki_order, "Suzuki");
   (void)leapfrog_base(base);
-  MethodInfo info{.name = std::move(name), .family = "composition", .order = order, .symmetric = true,
-                  .symplectic = true, .source = "Suzuki, Phys. Lett. A 146 (1990) 319",
+  MethodInfo info{.name = std::move(name),
+                  .family = "composition",
+                  .order = order,
+                  .symmetric = true,
+                  .symplectic = true,
+                  .source = "Suzuki, Phys. Lett. A 146 (1990) 319",
                   .description = "Suzuki 5-fold fractal composition of order " + std::to_string(order) + " on the " +
                                  detail::base_label(base),
                   .aliases = {}};
@@ -148,24 +156,36 @@ inline std::vector<CompositionTable> composition_tables() {
       // those of HLW (2006) eq V.(3.11) and gni_comp.f METHC=67. All four are taken as published: the
       // central one differs from 1 - 2(g1+g2+g3) by 1e-26 (rounding of the last digit). The same holds
       // for the other tables: the weights sum to 1 within 3e-26.
-      {"Y6", 6, "Yoshida, Phys. Lett. A 150 (1990) 262, solution A; digits of Hairer-Lubich-Wanner (2006) eq V.3.11",
-       "Yoshida's 7-stage sixth-order composition (solution A)", {"yoshida6", "Y6A"},
+      {"Y6",
+       6,
+       "Yoshida, Phys. Lett. A 150 (1990) 262, solution A; digits of Hairer-Lubich-Wanner (2006) eq V.3.11",
+       "Yoshida's 7-stage sixth-order composition (solution A)",
+       {"yoshida6", "Y6A"},
        {"0.78451361047755726381949763", "0.23557321335935813368479318", "-1.17767998417887100694641568",
         "1.31518632068391121888424973"}},
       // Kahan & Li (1997), s9odr6a; HLW (2006) eq V.(3.12); OrdinaryDiffEq.jl KahanLi6.
-      {"KL6", 6, "Kahan & Li, Math. Comp. 66 (1997) 1089, s9odr6a", "Kahan-Li 9-stage sixth-order composition",
+      {"KL6",
+       6,
+       "Kahan & Li, Math. Comp. 66 (1997) 1089, s9odr6a",
+       "Kahan-Li 9-stage sixth-order composition",
        {"kahan-li6", "s9odr6a"},
        {"0.39216144400731413927925056", "0.33259913678935943859974864", "-0.70624617255763935980996482",
         "0.08221359629355080023149045", "0.79854399093482996339895035"}},
       // Kahan & Li (1997), s17odr8a; HLW (2006) eq V.(3.14); OrdinaryDiffEq.jl KahanLi8.
-      {"KL8", 8, "Kahan & Li, Math. Comp. 66 (1997) 1089, s17odr8a", "Kahan-Li 17-stage eighth-order composition",
+      {"KL8",
+       8,
+       "Kahan & Li, Math. Comp. 66 (1997) 1089, s17odr8a",
+       "Kahan-Li 17-stage eighth-order composition",
        {"kahan-li8", "s17odr8a"},
        {"0.13020248308889008087881763", "0.56116298177510838456196441", "-0.38947496264484728640807860",
         "0.15884190655515560089621075", "-0.39590389413323757733623154", "0.18453964097831570709183254",
         "0.25837438768632204729397911", "0.29501172360931029887096624", "-0.60550853383003451169892108"}},
       // Sofroniou & Spaletta (2005), 35 stages, order 10; HLW (2006) Sec. V.3.2 (p10s35); OrdinaryDiffEq.jl SofSpa10.
-      {"SS10", 10, "Sofroniou & Spaletta, Optim. Methods Softw. 20 (2005) 597",
-       "Sofroniou-Spaletta 35-stage tenth-order composition", {"sofroniou-spaletta10", "SofSpa10"},
+      {"SS10",
+       10,
+       "Sofroniou & Spaletta, Optim. Methods Softw. 20 (2005) 597",
+       "Sofroniou-Spaletta 35-stage tenth-order composition",
+       {"sofroniou-spaletta10", "SofSpa10"},
        {"0.07879572252168641926390768", "0.31309610341510852776481247", "0.02791838323507806610952027",
         "-0.22959284159390709415121340", "0.13096206107716486317465686", "-0.26973340565451071434460973",
         "0.07497334315589143566613711", "0.11199342399981020488957508", "0.36613344954622675119314812",
@@ -191,13 +211,18 @@ inline std::vector<MethodDef> compositions() {
     // Y4 = triple jump of order 4. On PV it equals FR (Forest-Ruth, position-first), on VV FR-V; the
     // catalog keeps both names (the test checks that the coefficients agree).
     MethodDef y4 = triple_jump_method(4, base, "Y4" + suffix);
-    y4.info.description = "Yoshida triple jump of order 4 on the " + detail::base_label(base) +
-                          (base == "PV" ? " (= FR)" : " (= FR-V)");
+    y4.info.description =
+        "Yoshida triple jump of order 4 on the " + detail::base_label(base) + (base == "PV" ? " (= FR)" : " (= FR-V)");
     if (base == "PV") y4.info.aliases = {"yoshida4", "triplejump4"};
     m.push_back(std::move(y4));
     for (const auto& t : composition_tables()) {
-      MethodInfo info{.name = t.name + suffix, .family = "composition", .order = t.order, .symmetric = true,
-                      .symplectic = true, .published_digits = 26, .source = t.source,
+      MethodInfo info{.name = t.name + suffix,
+                      .family = "composition",
+                      .order = t.order,
+                      .symmetric = true,
+                      .symplectic = true,
+                      .published_digits = 26,
+                      .source = t.source,
                       .description = t.description + " on the " + detail::base_label(base),
                       .aliases = base == "PV" ? t.aliases : std::vector<std::string>{}};
       m.push_back({info, [t, base] { return MethodData{compose(leapfrog_base(base), table_weights(t))}; }});

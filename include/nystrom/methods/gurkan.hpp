@@ -42,11 +42,13 @@
 namespace nystrom::methods {
 
 /// RKNA scheme (eq 3.6) in time order: drift alpha_1, kick beta_1, ..., kick beta_s, drift alpha_{s+1}.
-inline SplittingScheme<bigcomplex> rkna_scheme(const std::vector<bigcomplex>& alpha, const std::vector<bigcomplex>& beta) {
+inline SplittingScheme<bigcomplex> rkna_scheme(const std::vector<bigcomplex>& alpha,
+                                               const std::vector<bigcomplex>& beta) {
   return alternating(Flow::drift, alpha, beta);
 }
 /// RKNB scheme (eq 3.7) in time order: kick beta_1, drift alpha_1, ..., drift alpha_s, kick beta_{s+1}.
-inline SplittingScheme<bigcomplex> rknb_scheme(const std::vector<bigcomplex>& alpha, const std::vector<bigcomplex>& beta) {
+inline SplittingScheme<bigcomplex> rknb_scheme(const std::vector<bigcomplex>& alpha,
+                                               const std::vector<bigcomplex>& beta) {
   return alternating(Flow::kick, beta, alpha);
 }
 
@@ -81,8 +83,8 @@ inline SplittingScheme<bigcomplex> gurkan_br1() {
 inline SplittingScheme<bigcomplex> gurkan_br2() {
   return rknb_scheme(bigs({"0.42637413177222316", "-0.82438794434938248", "-0.63140077574154094", "0.38590710518893978",
                            "1.6435074831297605"}),
-                     bigs({"0.15102308452230116", "0.72768821316253478", "-0.26217627934521390", "-0.044211509719803855",
-                           "0.23596222045571453", "0.19171427092446728"}));
+                     bigs({"0.15102308452230116", "0.72768821316253478", "-0.26217627934521390",
+                           "-0.044211509719803855", "0.23596222045571453", "0.19171427092446728"}));
 }
 inline SplittingScheme<bigcomplex> gurkan_br3() {
   return rknb_scheme(bigs({"1.0413749845202060", "-0.61784769849171965", "0.62570540985789957", "-0.63446409452971410",
@@ -161,45 +163,114 @@ inline std::vector<MethodDef> gurkan() {
   };
   const std::string rkna = "RKNA scheme, eq (3.6), drift first";
   const std::string rknb = "RKNB scheme, eq (3.7), kick first";
-  add({.name = "AR1", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.1", .description = "real fifth-order RKN splitting AR1, " + rkna, .aliases = {"RKNar1"}},
+  add({.name = "AR1",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.1",
+       .description = "real fifth-order RKN splitting AR1, " + rkna,
+       .aliases = {"RKNar1"}},
       gurkan_ar1);
-  add({.name = "AR2", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.1", .description = "real fifth-order RKN splitting AR2, " + rkna, .aliases = {"RKNar2"}},
+  add({.name = "AR2",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.1",
+       .description = "real fifth-order RKN splitting AR2, " + rkna,
+       .aliases = {"RKNar2"}},
       gurkan_ar2);
-  add({.name = "BR1", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.1", .description = "real fifth-order RKN splitting BR1, " + rknb, .aliases = {"RKNbr1"}},
+  add({.name = "BR1",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.1",
+       .description = "real fifth-order RKN splitting BR1, " + rknb,
+       .aliases = {"RKNbr1"}},
       gurkan_br1);
-  add({.name = "BR2", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.1", .description = "real fifth-order RKN splitting BR2, " + rknb, .aliases = {"RKNbr2"}},
+  add({.name = "BR2",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.1",
+       .description = "real fifth-order RKN splitting BR2, " + rknb,
+       .aliases = {"RKNbr2"}},
       gurkan_br2);
-  add({.name = "BR3", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.1", .description = "real fifth-order RKN splitting BR3, " + rknb, .aliases = {"RKNbr3"}},
+  add({.name = "BR3",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.1",
+       .description = "real fifth-order RKN splitting BR3, " + rknb,
+       .aliases = {"RKNbr3"}},
       gurkan_br3);
   const std::string cx = " (complex, skew-symmetric; missing coefficients from skew-symmetry and sum = 1)";
-  add({.name = "AC1", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.2", .description = "complex fifth-order RKN splitting AC1, " + rkna + cx,
+  add({.name = "AC1",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.2",
+       .description = "complex fifth-order RKN splitting AC1, " + rkna + cx,
        .aliases = {"RKNac1"}},
       gurkan_ac1);
-  add({.name = "AC2", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.2", .description = "complex fifth-order RKN splitting AC2, " + rkna + cx,
+  add({.name = "AC2",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.2",
+       .description = "complex fifth-order RKN splitting AC2, " + rkna + cx,
        .aliases = {"RKNac2"}},
       gurkan_ac2);
-  add({.name = "BC1", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.2", .description = "complex fifth-order RKN splitting BC1, " + rknb + cx,
+  add({.name = "BC1",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.2",
+       .description = "complex fifth-order RKN splitting BC1, " + rknb + cx,
        .aliases = {"RKNbc1"}},
       gurkan_bc1);
-  add({.name = "BC2", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
-       .source = src + ", Table 4.2", .description = "complex fifth-order RKN splitting BC2, " + rknb + cx,
+  add({.name = "BC2",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
+       .source = src + ", Table 4.2",
+       .description = "complex fifth-order RKN splitting BC2, " + rknb + cx,
        .aliases = {"RKNbc2"}},
       gurkan_bc2);
-  add({.name = "AC1-6", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true, .published_digits = 16,
+  add({.name = "AC1-6",
+       .family = "splitting",
+       .order = 5,
+       .symmetric = false,
+       .symplectic = true,
+       .published_digits = 16,
        .source = src + ", eq (6.1)",
        .description = "complex six-stage fifth-order RKN splitting optimized from AC1, kick first (skew-symmetric)",
        .aliases = {"RKNac1-6"}},
       gurkan_ac1_6);
-  add({.name = "Chambers", .family = "splitting", .order = 3, .symmetric = false, .symplectic = true,
-       .source = "Chambers, Astron. J. 126 (2003) 1119", .description = "Chambers' complex third-order splitting, drift first",
+  add({.name = "Chambers",
+       .family = "splitting",
+       .order = 3,
+       .symmetric = false,
+       .symplectic = true,
+       .source = "Chambers, Astron. J. 126 (2003) 1119",
+       .description = "Chambers' complex third-order splitting, drift first",
        .aliases = {"chambers3"}},
       chambers2003);
   return m;

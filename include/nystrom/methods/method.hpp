@@ -26,9 +26,9 @@ struct MethodInfo {
   bool symmetric = false;
   bool symplectic = false;
   bool complex = false;
-  bool adaptive = false;      // embedded pair with step-size control
-  int published_digits = 0;   // 0: exact (rational or closed form); else digits of the published table
-  std::string source;         // the publication the coefficients come from
+  bool adaptive = false;     // embedded pair with step-size control
+  int published_digits = 0;  // 0: exact (rational or closed form); else digits of the published table
+  std::string source;        // the publication the coefficients come from
   std::string description;
   std::vector<std::string> aliases;
 };

@@ -129,12 +129,12 @@ struct LinearCoef {
 };
 
 struct Parametrization {
-  std::vector<Flow> flows;           // normalized scheme, time order
-  std::vector<LinearCoef> coefs;     // one per sub-step
-  std::vector<bigfloat> start;       // the published parameters
-  bool complex = false;              // some coefficient is complex
-  bool composition = false;          // parametrised by composition weights
-  std::vector<std::string> names;    // "w3", "re b2", ... for messages
+  std::vector<Flow> flows;         // normalized scheme, time order
+  std::vector<LinearCoef> coefs;   // one per sub-step
+  std::vector<bigfloat> start;     // the published parameters
+  bool complex = false;            // some coefficient is complex
+  bool composition = false;        // parametrised by composition weights
+  std::vector<std::string> names;  // "w3", "re b2", ... for messages
 };
 
 inline bool close(const bigcomplex& a, const bigcomplex& b, const bigfloat& tol) {
@@ -319,7 +319,8 @@ inline bigfloat max_abs(const std::vector<bigfloat>& a) {
 
 /// Greedy choice of independent rows of J (largest remaining component first, Gram-Schmidt with
 /// re-orthogonalisation) until the remaining components fall below rel_tol times the largest row.
-inline std::vector<std::size_t> independent_rows(const std::vector<std::vector<bigfloat>>& jac, const bigfloat& rel_tol) {
+inline std::vector<std::size_t> independent_rows(const std::vector<std::vector<bigfloat>>& jac,
+                                                 const bigfloat& rel_tol) {
   std::vector<std::vector<bigfloat>> rest = jac;
   std::vector<std::vector<bigfloat>> basis;
   std::vector<std::size_t> chosen;
@@ -536,8 +537,8 @@ inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published,
     const bool tiny_step = max_abs(dx) <= ldexp(size, static_cast<int>(8 - prec));
     evaluate(x, newton);
     const bigfloat now = selected_max();
-    if (tiny_step || now == 0) break;                    // converged to rounding
-    if (max_abs(f) <= target && !(now < last)) break;    // no further progress
+    if (tiny_step || now == 0) break;                  // converged to rounding
+    if (max_abs(f) <= target && !(now < last)) break;  // no further progress
     if (!newton && strategy == RefineStrategy::automatic) {
       // Cost model, in residual evaluations: the chord needs missing / per_step more of them; Newton
       // doubles the correct bits per step, each step a Jacobian (measured: worth about 2 (parameters
@@ -546,7 +547,8 @@ inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published,
       const double have = std::max(1.0, -static_cast<double>(log2(now)));
       const double want = static_cast<double>(-log2(target));
       const double chord_cost = (want - have) / std::max(per_step, 1e-3);
-      const double newton_cost = 2.0 * static_cast<double>(x.size() + 1) * std::ceil(std::log2(std::max(2.0, want / have)));
+      const double newton_cost =
+          2.0 * static_cast<double>(x.size() + 1) * std::ceil(std::log2(std::max(2.0, want / have)));
       if (!(per_step > 1) || newton_cost < chord_cost) {
         newton = true;
         evaluate(x, true);

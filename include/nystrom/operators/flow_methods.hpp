@@ -131,16 +131,16 @@ inline FlowMethod mpe_over(const std::string& spec, const std::string& base_spec
     throw std::invalid_argument("'" + spec + "': the base of a multi-product expansion must be a symmetric splitting " +
                                 "of even order, not '" + base.info.name + "'");
   FlowMpeDef m{k, base.info.name, base.info.order, *sp, extrapolation_coefficients(k, base.info.order)};
-  MethodInfo info{.name = spec,
-                  .family = "mpe",
-                  .order = base.info.order + 2 * (static_cast<int>(k.size()) - 1),
-                  .symmetric = false,
-                  .symplectic = false,
-                  .complex = base.info.complex,
-                  .source = "Chin (2010) eq (27), extrapolation of a symmetric order-" +
-                            std::to_string(base.info.order) + " base",
-                  .description = "multi-product expansion {" + seq + "} over " + base.info.name,
-                  .aliases = {}};
+  MethodInfo info{
+      .name = spec,
+      .family = "mpe",
+      .order = base.info.order + 2 * (static_cast<int>(k.size()) - 1),
+      .symmetric = false,
+      .symplectic = false,
+      .complex = base.info.complex,
+      .source = "Chin (2010) eq (27), extrapolation of a symmetric order-" + std::to_string(base.info.order) + " base",
+      .description = "multi-product expansion {" + seq + "} over " + base.info.name,
+      .aliases = {}};
   return {info, m};
 }
 

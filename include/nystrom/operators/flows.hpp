@@ -19,9 +19,9 @@
 // its "kicks" B, in the order they are applied.
 #pragma once
 
+#include <cmath>
 #include <complex>
 #include <concepts>
-#include <cmath>
 #include <cstddef>
 #include <stdexcept>
 #include <string>

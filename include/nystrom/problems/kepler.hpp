@@ -42,8 +42,8 @@ template <class T>
 T eccentric_anomaly(const T& M, const T& e) {
   using std::abs;
   using std::acos;
-  using std::floor;
   using std::cos;
+  using std::floor;
   using std::sin;
   const T pi = acos(T(-1));
   // Reduce M to [-pi, pi].

@@ -224,7 +224,8 @@ NYSTROM_TARGET_AVX512 inline void avx512_complex_inv_pow32(__m512d a, __m512d b,
 }
 
 /// avx512_complex_inv_pow32 on 8 lanes in memory (for tests: the caller checks nbody_simd_available()).
-NYSTROM_TARGET_AVX512 inline void avx512_complex_inv_pow32_lanes(const double* a, const double* b, double* wr, double* wi) {
+NYSTROM_TARGET_AVX512 inline void avx512_complex_inv_pow32_lanes(const double* a, const double* b, double* wr,
+                                                                 double* wi) {
   __m512d r, i;
   avx512_complex_inv_pow32(_mm512_loadu_pd(a), _mm512_loadu_pd(b), r, i);
   _mm512_storeu_pd(wr, r);
@@ -319,7 +320,8 @@ struct ComplexTileData {
 };
 
 /// Complex separation d = q_j - q_i of row q (6 broadcast coordinates) and the 8 partners at j.
-NYSTROM_TARGET_AVX512 inline void avx512_complex_d(const ComplexTileData& d, std::size_t j, const __m512d* q, __m512d* dd) {
+NYSTROM_TARGET_AVX512 inline void avx512_complex_d(const ComplexTileData& d, std::size_t j, const __m512d* q,
+                                                   __m512d* dd) {
   dd[0] = _mm512_sub_pd(_mm512_loadu_pd(d.xr + j), q[0]);
   dd[1] = _mm512_sub_pd(_mm512_loadu_pd(d.xi + j), q[1]);
   dd[2] = _mm512_sub_pd(_mm512_loadu_pd(d.yr + j), q[2]);
@@ -331,8 +333,8 @@ NYSTROM_TARGET_AVX512 inline void avx512_complex_d(const ComplexTileData& d, std
 /// w = r2^{-3/2} for the 8 partners at j of row q, r2 = d.d + eps2 (complex); lanes with r2 == 0 give
 /// w = 0 when Masked.
 template <bool Masked>
-NYSTROM_TARGET_AVX512 inline void avx512_complex_w(const ComplexTileData& d, std::size_t j, const __m512d* q, __m512d e2,
-                                                   __m512d& wr, __m512d& wi) {
+NYSTROM_TARGET_AVX512 inline void avx512_complex_w(const ComplexTileData& d, std::size_t j, const __m512d* q,
+                                                   __m512d e2, __m512d& wr, __m512d& wi) {
   __m512d dd[6];
   avx512_complex_d(d, j, q, dd);
   // Re r2 in two chains (x and z; y), to shorten the dependency chain.
@@ -345,8 +347,8 @@ NYSTROM_TARGET_AVX512 inline void avx512_complex_w(const ComplexTileData& d, std
   b = _mm512_add_pd(b, b);
   avx512_complex_inv_pow32(a, b, wr, wi);
   if constexpr (Masked) {
-    const __mmask8 nz =
-        _mm512_cmp_pd_mask(a, _mm512_setzero_pd(), _CMP_NEQ_OQ) | _mm512_cmp_pd_mask(b, _mm512_setzero_pd(), _CMP_NEQ_OQ);
+    const __mmask8 nz = _mm512_cmp_pd_mask(a, _mm512_setzero_pd(), _CMP_NEQ_OQ) |
+                        _mm512_cmp_pd_mask(b, _mm512_setzero_pd(), _CMP_NEQ_OQ);
     wr = _mm512_maskz_mov_pd(nz, wr);
     wi = _mm512_maskz_mov_pd(nz, wi);
   }
@@ -394,7 +396,8 @@ NYSTROM_TARGET_AVX512 inline void avx512_complex_row(const ComplexTileData& d, s
 /// Contributions within one block: rows i, i+1 at a time, each summing over all j of the block in order
 /// (i's own term is zero: d = 0, or masked).
 template <bool Masked>
-NYSTROM_TARGET_AVX512 inline void avx512_diag_complex(const ComplexTileData& d, std::size_t i0, std::size_t B, double eps2) {
+NYSTROM_TARGET_AVX512 inline void avx512_diag_complex(const ComplexTileData& d, std::size_t i0, std::size_t B,
+                                                      double eps2) {
   const __m512d e2 = _mm512_set1_pd(eps2);
   double* const out[6] = {d.axr, d.axi, d.ayr, d.ayi, d.azr, d.azi};
   alignas(64) double wbuf[4 * complex_max_block];
@@ -659,8 +662,8 @@ class NBodyForce {
     // With eps2 >= 1e-200, r2 >= eps2 > 0 and r2^{-3/2} is finite: the zero-separation mask is not needed.
     const bool masked = !(e2 >= 1e-200);
     if constexpr (cplx) {
-      const detail::ComplexTileData d{pos,         pos + L,     pos + 2 * L, pos + 3 * L, pos + 4 * L, pos + 5 * L, mass,
-                                      acc,         acc + L,     acc + 2 * L, acc + 3 * L, acc + 4 * L, acc + 5 * L};
+      const detail::ComplexTileData d{pos, pos + L, pos + 2 * L, pos + 3 * L, pos + 4 * L, pos + 5 * L, mass,
+                                      acc, acc + L, acc + 2 * L, acc + 3 * L, acc + 4 * L, acc + 5 * L};
       if (masked)
         detail::nbody_tiles(
             s.nb, nt, [&](std::size_t I) { detail::avx512_diag_complex<true>(d, I * B, B, e2); },

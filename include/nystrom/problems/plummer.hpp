@@ -49,9 +49,7 @@ namespace nystrom {
 namespace detail {
 
 /// Uniform double in the open interval (0, 1) from 53 random bits.
-inline double uniform01(std::mt19937_64& g) {
-  return (static_cast<double>(g() >> 11) + 0.5) * 0x1.0p-53;
-}
+inline double uniform01(std::mt19937_64& g) { return (static_cast<double>(g() >> 11) + 0.5) * 0x1.0p-53; }
 
 }  // namespace detail
 
@@ -187,7 +185,8 @@ ParticleSet<T> load_particles(const std::string& path) {
       row[static_cast<std::size_t>(k)] = v;
       s = end;
     }
-    if (k != 7) throw std::invalid_argument(where + "expected 7 numbers (m x y z vx vy vz), found " + std::to_string(k));
+    if (k != 7)
+      throw std::invalid_argument(where + "expected 7 numbers (m x y z vx vy vz), found " + std::to_string(k));
     if (!(row[0] > 0.0)) throw std::invalid_argument(where + "mass must be positive");
     rows.push_back(row);
   }
@@ -242,8 +241,8 @@ void save_particles(const std::string& path, const ParticleSet<T>& p) {
   std::string text = "m,x,y,z,vx,vy,vz\n";
   char buf[64];
   for (std::size_t i = 0; i < n; ++i) {
-    const double row[7] = {as_double(p.m[i]),         as_double(p.s.q[i]),         as_double(p.s.q[n + i]),
-                           as_double(p.s.q[2 * n + i]), as_double(p.s.v[i]),         as_double(p.s.v[n + i]),
+    const double row[7] = {as_double(p.m[i]),           as_double(p.s.q[i]), as_double(p.s.q[n + i]),
+                           as_double(p.s.q[2 * n + i]), as_double(p.s.v[i]), as_double(p.s.v[n + i]),
                            as_double(p.s.v[2 * n + i])};
     for (int k = 0; k < 7; ++k) {
       std::snprintf(buf, sizeof buf, "%.17g%s", row[k], k == 6 ? "\n" : ",");

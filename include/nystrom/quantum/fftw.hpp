@@ -84,8 +84,8 @@ using Field = std::vector<std::complex<R>, FftwAllocator<std::complex<R>>>;
 
 /// How plans are made.
 struct FftOptions {
-  int threads = 1;           // FFTW threads per transform (ignored without NYSTROM_HAVE_FFTW_THREADS)
-  bool measure = false;      // FFTW_MEASURE instead of FFTW_ESTIMATE (slower to plan, faster to run)
+  int threads = 1;          // FFTW threads per transform (ignored without NYSTROM_HAVE_FFTW_THREADS)
+  bool measure = false;     // FFTW_MEASURE instead of FFTW_ESTIMATE (slower to plan, faster to run)
   std::string wisdom_file;  // read before planning and written after, when not empty
 };
 

@@ -47,7 +47,7 @@ struct QuantumResult {
   double norm = 0, norm_drift = 0, energy = 0, chemical_potential = 0;
   std::vector<double> mean_x, mean_p;
   double exact_error = std::numeric_limits<double>::quiet_NaN();  // L2 distance to the exact solution, if known
-  std::string exact_solution;                                      // "harmonic coherent state", "free Gaussian", ""
+  std::string exact_solution;                                     // "harmonic coherent state", "free Gaussian", ""
   long fft_count = 0;
   double seconds = 0;
   std::vector<QuantumSample> samples;
@@ -74,7 +74,7 @@ QuantumResult solve(const QuantumProblem<R>& p, const std::string& method, R dt,
       if (!std::isfinite(static_cast<double>(x))) throw std::invalid_argument("x0 and p0 must be finite");
   const Grid<R> grid(p.dims, p.grid, p.box);
   const operators::FlowMethod fm = operators::resolve_flow_method(method, operators::OperatorStructure::rkn,
-                                                       scalar_traits<R>::bits(), scalar_traits<R>::name());
+                                                                  scalar_traits<R>::bits(), scalar_traits<R>::name());
   const PotentialFunction<R> vf = p.user ? p.user : named_potential<R>(p.potential);
   SchrodingerFlows<R> flows(grid, sample_potential(grid, vf), p.time, p.g, p.fft);
   operators::FlowIntegrator<SchrodingerFlows<R>> integ(fm);
@@ -91,8 +91,10 @@ QuantumResult solve(const QuantumProblem<R>& p, const std::string& method, R dt,
   const double norm0 = static_cast<double>(observe(flows, psi).norm);
   auto record = [&](long done) {
     const auto o = observe(flows, psi);
-    QuantumSample s{static_cast<double>(dt) * static_cast<double>(done), static_cast<double>(o.norm),
-                    static_cast<double>(o.energy), {}};
+    QuantumSample s{static_cast<double>(dt) * static_cast<double>(done),
+                    static_cast<double>(o.norm),
+                    static_cast<double>(o.energy),
+                    {}};
     for (R x : o.mean_x) s.mean_x.push_back(static_cast<double>(x));
     r.samples.push_back(std::move(s));
   };

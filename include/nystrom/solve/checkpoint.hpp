@@ -25,15 +25,15 @@ namespace nystrom {
 template <class T>
 struct Checkpoint {
   static constexpr int format_version = 1;
-  std::string method;   // the method specification it was taken with
-  std::string problem;  // the caller's description of the problem (refused when it differs)
-  std::string engine;   // "fixed", "adaptive-rkn", "adaptive-mpe", "gbs"
-  T t{};                // the time of the step boundary
-  long step_index = 0;  // fixed step: steps done
-  std::vector<T> state;  // the engine's q then v (complex: real and imaginary parts), flattened
-  std::vector<T> carry;  // the compensation carries, cq then cv, flattened (empty: none)
-  T h_want{}, hmax{};  // adaptive: next step and step bound; GBS: next step (h_want)
-  T span{};            // GBS: the time since the start of its span
+  std::string method;             // the method specification it was taken with
+  std::string problem;            // the caller's description of the problem (refused when it differs)
+  std::string engine;             // "fixed", "adaptive-rkn", "adaptive-mpe", "gbs"
+  T t{};                          // the time of the step boundary
+  long step_index = 0;            // fixed step: steps done
+  std::vector<T> state;           // the engine's q then v (complex: real and imaginary parts), flattened
+  std::vector<T> carry;           // the compensation carries, cq then cv, flattened (empty: none)
+  T h_want{}, hmax{};             // adaptive: next step and step bound; GBS: next step (h_want)
+  T span{};                       // GBS: the time since the start of its span
   double q_prev = 0, h_prev = 0;  // adaptive: the predictive controller's history
   int columns = 0;                // GBS: the order (columns of the extrapolation table)
   bool last_rejected = false;
@@ -57,7 +57,8 @@ T parse_hex(const std::string& s) {
   errno = 0;
   char* end = nullptr;
   const long double x = std::strtold(s.c_str(), &end);
-  if (end == s.c_str() || *end != '\0' || errno == ERANGE) throw invalid_input("checkpoint: malformed number '" + s + "'");
+  if (end == s.c_str() || *end != '\0' || errno == ERANGE)
+    throw invalid_input("checkpoint: malformed number '" + s + "'");
   return static_cast<T>(x);
 }
 
@@ -131,21 +132,37 @@ Checkpoint<T> checkpoint_from_text(const std::string& text) {
       v.clear();
       for (long i = 0; i < n; ++i) v.push_back(num());
     };
-    if (key == "method") c.method = rest;
-    else if (key == "problem") c.problem = rest;
-    else if (key == "engine") c.engine = rest;
-    else if (key == "t") c.t = num();
-    else if (key == "step_index") { if (!(l >> c.step_index)) throw fail("step_index"); }
-    else if (key == "state") vec(c.state);
-    else if (key == "carry") vec(c.carry);
-    else if (key == "h_want") c.h_want = num();
-    else if (key == "hmax") c.hmax = num();
-    else if (key == "span") c.span = num();
-    else if (key == "q_prev") c.q_prev = static_cast<double>(parse_hex<long double>((l >> w, w)));
-    else if (key == "h_prev") c.h_prev = static_cast<double>(parse_hex<long double>((l >> w, w)));
-    else if (key == "columns") { if (!(l >> c.columns)) throw fail("columns"); }
-    else if (key == "last_rejected") { int b = 0; if (!(l >> b)) throw fail("last_rejected"); c.last_rejected = b != 0; }
-    else if (key == "counters") {
+    if (key == "method")
+      c.method = rest;
+    else if (key == "problem")
+      c.problem = rest;
+    else if (key == "engine")
+      c.engine = rest;
+    else if (key == "t")
+      c.t = num();
+    else if (key == "step_index") {
+      if (!(l >> c.step_index)) throw fail("step_index");
+    } else if (key == "state")
+      vec(c.state);
+    else if (key == "carry")
+      vec(c.carry);
+    else if (key == "h_want")
+      c.h_want = num();
+    else if (key == "hmax")
+      c.hmax = num();
+    else if (key == "span")
+      c.span = num();
+    else if (key == "q_prev")
+      c.q_prev = static_cast<double>(parse_hex<long double>((l >> w, w)));
+    else if (key == "h_prev")
+      c.h_prev = static_cast<double>(parse_hex<long double>((l >> w, w)));
+    else if (key == "columns") {
+      if (!(l >> c.columns)) throw fail("columns");
+    } else if (key == "last_rejected") {
+      int b = 0;
+      if (!(l >> b)) throw fail("last_rejected");
+      c.last_rejected = b != 0;
+    } else if (key == "counters") {
       if (!(l >> c.force_evals >> c.output_force_evals >> c.accepted >> c.rejected)) throw fail("counters");
     } else if (key == "end") {
       ended = true;

@@ -25,7 +25,9 @@ concept AutonomousForce = std::invocable<F&, const V&, V&>;
 
 /// A time-dependent force for state type V: force(t, q, a).
 template <class F, class V>
-concept TimeDependentForce = std::invocable<F&, const real_t<typename V::value_type>&, const V&, V&>;
+concept TimeDependentForce = std::invocable < F&,
+        const real_t<typename V::value_type>
+&, const V&, V& > ;
 
 /// Either form.
 template <class F, class V>

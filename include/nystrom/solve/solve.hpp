@@ -531,7 +531,8 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, Solution
   long evals0 = 0, acc0 = 0, rej0 = 0;
   R tau = tau0;
   if (resume) {
-    if (resume->engine != name) throw invalid_input(std::string("checkpoint of another engine (") + resume->engine + ")");
+    if (resume->engine != name)
+      throw invalid_input(std::string("checkpoint of another engine (") + resume->engine + ")");
     std::size_t pos = unflatten(resume->state, 0, s.q);
     pos = unflatten(resume->state, pos, s.v);
     if (pos != resume->state.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
@@ -545,8 +546,8 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, Solution
       }
     }
     tau = sgn_mul(dir, resume->t);
-    engine.set_resume_point({tau, resume->h_want, resume->hmax, resume->last_rejected, resume->q_prev,
-                             resume->h_prev, true});
+    engine.set_resume_point(
+        {tau, resume->h_want, resume->hmax, resume->last_rejected, resume->q_prev, resume->h_prev, true});
     evals0 = resume->force_evals;
     acc0 = resume->accepted;
     rej0 = resume->rejected;
@@ -710,7 +711,8 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
     if (!std::isfinite(te)) throw invalid_input("output times must be finite");
     if (sgn_mul(dir, R(te)) < sgn_mul(dir, prob.t0))
       throw invalid_input("output time " + adaptive_detail::sci(te) + " lies before t0");
-    if (sgn_mul(dir, R(te)) > sgn_mul(dir, prob.t1)) throw invalid_input("output time " + adaptive_detail::sci(te) + " lies after t1");
+    if (sgn_mul(dir, R(te)) > sgn_mul(dir, prob.t1))
+      throw invalid_input("output time " + adaptive_detail::sci(te) + " lies after t1");
     if (i > 0 && dir * te < dir * opt.t_eval[i - 1])
       throw invalid_input("output times must be ordered in the direction of integration");
   }

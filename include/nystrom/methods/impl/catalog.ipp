@@ -41,7 +41,7 @@ NYSTROM_DECL void finalize_info(MethodDef& d) {
     in.fsal = s.fsal();
     in.complex = std::any_of(s.steps.begin(), s.steps.end(), [](const auto& x) { return !x.coef.is_real(); });
     if (in.complex) in.symplectic = false;  // imaginary parts are dropped after each step
-    if (in.complex && in.fsal) {  // ... so the last force, taken at a complex position, is not reusable
+    if (in.complex && in.fsal) {            // ... so the last force, taken at a complex position, is not reusable
       in.fsal = false;
       ++in.forces_per_step;
     }
@@ -107,7 +107,8 @@ NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
   // Adaptive multi-product methods (engines/adaptive_mpe.hpp): M<2n>-adaptive, mpe-adaptive:K, mpe-vv-adaptive:K.
   auto adaptive_mpe = [&finalize](const std::vector<long>& k, const std::string& base, const std::string& name) {
     if (k.size() < 2)
-      throw std::invalid_argument("an adaptive MPE needs at least two products (the error estimate drops one): '" + name + "'");
+      throw std::invalid_argument("an adaptive MPE needs at least two products (the error estimate drops one): '" +
+                                  name + "'");
     MethodDef d = methods::mpe_method(k, base, name);
     d.info.adaptive = true;
     d.info.description += ", adaptive step (embedded estimate: the products without the largest k)";
@@ -129,7 +130,8 @@ NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
   if (ls.rfind("mpe-pv:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(7)), "PV", spec));
   if (ls.rfind("mpe-vv:", 0) == 0) return finalize(methods::mpe_method(parse_sequence(spec.substr(7)), "VV", spec));
   if (ls.size() >= 2 && ls[0] == 'm' && std::all_of(ls.begin() + 1, ls.end(), ::isdigit)) {
-    if (ls.size() > 10) throw std::invalid_argument("MPE order must be an even number between 2 and 400, got '" + spec + "'");
+    if (ls.size() > 10)
+      throw std::invalid_argument("MPE order must be an even number between 2 and 400, got '" + spec + "'");
     const long order = std::stol(ls.substr(1));
     if (order < 2 || order % 2 != 0 || order > 400)
       throw std::invalid_argument("MPE order must be an even number between 2 and 400, got '" + spec + "'");
@@ -137,19 +139,18 @@ NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
     for (long i = 1; i <= order / 2; ++i) k.push_back(i);
     return finalize(methods::mpe_method(k, "PV", "M" + std::to_string(order)));
   }
-  for (const auto& [prefix, base] : {std::pair<std::string, std::string>{"triplejump:", "PV"},
-                                     {"triplejump-pv:", "PV"},
-                                     {"triplejump-vv:", "VV"}})
+  for (const auto& [prefix, base] :
+       {std::pair<std::string, std::string>{"triplejump:", "PV"}, {"triplejump-pv:", "PV"}, {"triplejump-vv:", "VV"}})
     if (ls.rfind(prefix, 0) == 0)
-      return finalize(methods::triple_jump_method(methods::parse_composition_order(spec.substr(prefix.size()), spec),
-                                                  base, ls));
-  for (const auto& [prefix, base] : {std::pair<std::string, std::string>{"suzuki:", "PV"},
-                                     {"suzuki-pv:", "PV"},
-                                     {"suzuki-vv:", "VV"}})
+      return finalize(
+          methods::triple_jump_method(methods::parse_composition_order(spec.substr(prefix.size()), spec), base, ls));
+  for (const auto& [prefix, base] :
+       {std::pair<std::string, std::string>{"suzuki:", "PV"}, {"suzuki-pv:", "PV"}, {"suzuki-vv:", "VV"}})
     if (ls.rfind(prefix, 0) == 0)
       return finalize(
           methods::suzuki_method(methods::parse_composition_order(spec.substr(prefix.size()), spec), base, ls));
-  if (ls.rfind("file:", 0) == 0) return finalize(analysis::method_def_from_file(spec.substr(5)));  // analysis/method_file.hpp
+  if (ls.rfind("file:", 0) == 0)
+    return finalize(analysis::method_def_from_file(spec.substr(5)));  // analysis/method_file.hpp
   if (ls.rfind("adjoint:", 0) == 0) {
     // Nested adjoints are peeled off in a loop (a recursive descent overflowed the stack at a few thousand
     // levels); the adjoint is an involution, so only the parity of the nesting changes the method.
