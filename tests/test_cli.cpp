@@ -14,43 +14,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.hpp"
+
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string tool() {
-  const char* b = std::getenv("NYSTROM_BIN");
-  return b ? b : "nystrom";
-}
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() / ("nystrom-cli-" + std::to_string(::getpid()) + "-" +
-                                                     ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::filesystem::create_directories(d);
-  return d;
-}
-
-Result run(const std::string& args) {
-  const auto dir = temp_dir();
-  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = tool() + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using namespace cli_test;
 
 }  // namespace
 

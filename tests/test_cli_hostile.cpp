@@ -129,14 +129,24 @@ std::string repeat(const std::string& s, int n) {
 
 std::string sequence(int n) {
   std::string s;
-  for (int i = 1; i <= n; ++i) s += (i > 1 ? "," : "") + std::to_string(i);
+  for (int i = 1; i <= n; ++i) {  // appended piece by piece: GCC 12 reports a false -Warray-bounds for "x" + string
+    if (i > 1) s += ',';
+    s += std::to_string(i);
+  }
   return s;
 }
 
 // A splitting with `pairs` drift-kick pairs of equal coefficients 1/pairs: a valid first-order method file.
 std::string long_method_file(int pairs) {
   std::string s = "name long\norder 1\n";
-  for (int i = 0; i < pairs; ++i) s += "drift 1/" + std::to_string(pairs) + "\nkick 1/" + std::to_string(pairs) + "\n";
+  const std::string c = std::to_string(pairs);
+  for (int i = 0; i < pairs; ++i) {
+    s += "drift 1/";
+    s += c;
+    s += "\nkick 1/";
+    s += c;
+    s += '\n';
+  }
   return s;
 }
 
