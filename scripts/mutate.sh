@@ -18,7 +18,7 @@ build=${NYSTROM_MUTATE_DIR:-build/mutate}
 jobs=${NYSTROM_MUTATE_JOBS:-2}
 
 # One mutant per three lines: "@ FILE TEST-PROGRAMS (comma-separated) GTEST-FILTER", "- OLD TEXT",
-# "+ NEW TEXT". The old text must occur exactly once in the file.
+# "+ NEW TEXT" ("\\n" stands for a line break). The old text must occur exactly once in the file.
 mutants() {
   cat <<'EOF'
 @ include/nystrom/methods/chin2010.hpp test_order Catalog/ObservedOrder.*N4*
@@ -46,38 +46,38 @@ mutants() {
 - drift(1 - 2 * theta)
 + drift(1 - 2 * theta + theta / 1000)
 @ include/nystrom/methods/chin2010.hpp test_order Catalog/ObservedOrder.*N4*
-- .name = "N4", .family = "rkn", .order = 4
-+ .name = "N4", .family = "rkn", .order = 3
+- .name = "N4",\n                .family = "rkn",\n                .order = 4
++ .name = "N4",\n                .family = "rkn",\n                .order = 3
 @ include/nystrom/methods/chin2010.hpp test_order Catalog/ObservedOrder.*M8*
 - .order = 2 * static_cast<int>(k.size()),
 + .order = 2 * static_cast<int>(k.size()) + 2,
 @ include/nystrom/methods/chin2010.hpp test_properties *Aprime*
-- .name = "Aprime", .family = "rkn", .order = 4, .symmetric = true
-+ .name = "Aprime", .family = "rkn", .order = 4, .symmetric = false
+- .name = "Aprime",\n                .family = "rkn",\n                .order = 4,\n                .symmetric = true
++ .name = "Aprime",\n                .family = "rkn",\n                .order = 4,\n                .symmetric = false
 @ include/nystrom/methods/chin2010.hpp test_properties *M6_5F*
-- .name = "M6-5F", .family = "rkn", .order = 6, .symmetric = false
-+ .name = "M6-5F", .family = "rkn", .order = 6, .symmetric = true
+- .name = "M6-5F",\n                .family = "rkn",\n                .order = 6,\n                .symmetric = false
++ .name = "M6-5F",\n                .family = "rkn",\n                .order = 6,\n                .symmetric = true
 @ include/nystrom/methods/chin2010.hpp test_properties *VV_*
-- .name = "VV", .family = "splitting", .order = 2, .symmetric = true, .symplectic = true
-+ .name = "VV", .family = "splitting", .order = 2, .symmetric = true, .symplectic = false
+- .name = "VV",\n                .family = "splitting",\n                .order = 2,\n                .symmetric = true,\n                .symplectic = true
++ .name = "VV",\n                .family = "splitting",\n                .order = 2,\n                .symmetric = true,\n                .symplectic = false
 @ include/nystrom/methods/chin2010.hpp test_properties *M12*
-- .symmetric = false, .symplectic = false,  // a sum
-+ .symmetric = false, .symplectic = true,  // a sum
+- .symmetric = false,\n                  .symplectic = false,  // a sum
++ .symmetric = false,\n                  .symplectic = true,  // a sum
 @ include/nystrom/methods/chin2010.hpp test_properties *M14*
-- .symmetric = false, .symplectic = false,  // a sum
-+ .symmetric = true, .symplectic = false,  // a sum
+- .symmetric = false,\n                  .symplectic = false,  // a sum
++ .symmetric = true,\n                  .symplectic = false,  // a sum
 @ include/nystrom/methods/dormand_prince1987.hpp test_properties *DP12_*
-- .name = "DP12", .family = "rkn", .order = 12, .symmetric = false, .symplectic = false
-+ .name = "DP12", .family = "rkn", .order = 12, .symmetric = false, .symplectic = true
+- .name = "DP12",\n                .family = "rkn",\n                .order = 12,\n                .symmetric = false,\n                .symplectic = false
++ .name = "DP12",\n                .family = "rkn",\n                .order = 12,\n                .symmetric = false,\n                .symplectic = true
 @ include/nystrom/methods/dormand_prince1987.hpp test_properties *DP10*
-- .name = "DP10", .family = "rkn", .order = 10, .symmetric = false
-+ .name = "DP10", .family = "rkn", .order = 10, .symmetric = true
+- .name = "DP10",\n        .family = "rkn",\n        .order = 10,\n        .symmetric = false
++ .name = "DP10",\n        .family = "rkn",\n        .order = 10,\n        .symmetric = true
 @ include/nystrom/methods/gurkan.hpp test_properties *AR1*
-- .name = "AR1", .family = "splitting", .order = 5, .symmetric = false, .symplectic = true
-+ .name = "AR1", .family = "splitting", .order = 5, .symmetric = false, .symplectic = false
+- .name = "AR1",\n       .family = "splitting",\n       .order = 5,\n       .symmetric = false,\n       .symplectic = true
++ .name = "AR1",\n       .family = "splitting",\n       .order = 5,\n       .symmetric = false,\n       .symplectic = false
 @ include/nystrom/methods/gurkan.hpp test_properties *AC1_*
-- .name = "AC1", .family = "splitting", .order = 5, .symmetric = false
-+ .name = "AC1", .family = "splitting", .order = 5, .symmetric = true
+- .name = "AC1",\n       .family = "splitting",\n       .order = 5,\n       .symmetric = false
++ .name = "AC1",\n       .family = "splitting",\n       .order = 5,\n       .symmetric = true
 @ include/nystrom/methods/gurkan.hpp test_order Catalog/ObservedOrder.*AC1*
 - {"0.17916539354193987", "-0.067857083007249973"}
 + {"0.17916539354193987", "-0.077857083007249973"}
@@ -85,8 +85,8 @@ mutants() {
 - const bigcomplex a1(big("1/4"), 1 / (4 * s3));
 + const bigcomplex a1(big("1/4"), 1 / (5 * s3));
 @ include/nystrom/methods/gurkan.hpp test_order Catalog/ObservedOrder.*BR1*
-- .name = "BR1", .family = "splitting", .order = 5
-+ .name = "BR1", .family = "splitting", .order = 6
+- .name = "BR1",\n       .family = "splitting",\n       .order = 5
++ .name = "BR1",\n       .family = "splitting",\n       .order = 6
 @ include/nystrom/methods/compositions.hpp test_order Catalog/ObservedOrder.*Y6*
 - "0.78451361047755726381949763"
 + "0.78451361147755726381949763"
@@ -97,14 +97,14 @@ mutants() {
 - "0.05066509075992449633587434"
 + "0.05066509075992449633687434"
 @ include/nystrom/methods/compositions.hpp test_order Catalog/ObservedOrder.*KL6*
-- {"KL6", 6,
-+ {"KL6", 8,
+- {"KL6",\n       6,
++ {"KL6",\n       8,
 @ include/nystrom/methods/blanes_moan2002.hpp test_refine Refine.EveryDecimalSplitting*
 - "0.0378593198406116"
 + "0.0478593198406116"
 @ include/nystrom/methods/blanes_moan2002.hpp test_properties *RKNa14*
-- .name = "RKNa14", .family = "splitting", .order = 6, .symmetric = true
-+ .name = "RKNa14", .family = "splitting", .order = 6, .symmetric = false
+- .name = "RKNa14",\n                .family = "splitting",\n                .order = 6,\n                .symmetric = true
++ .name = "RKNa14",\n                .family = "splitting",\n                .order = 6,\n                .symmetric = false
 @ include/nystrom/engines/splitting.hpp test_mpe_schedule MpeSchedule.Kepler*
 - if (!(kick_first && p == 0 && valid)) {
 + if (!(kick_first && valid)) {
@@ -180,7 +180,7 @@ bad = 0
 lines = sys.stdin.read().splitlines()
 for n, rec in enumerate(lines, 1):
     f = rec.split(" ;; ")
-    c = open(f[0]).read().count(f[3])
+    c = open(f[0]).read().count(f[3].replace("\\n", "\n"))
     if c != 1:
         print(f"mutant {n}: occurs {c} times: {rec}")
         bad = 1
@@ -211,7 +211,7 @@ cmake -S "$build/src" -B "$build/obj" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLA
 substitute() {
   "$python" - "$1" "$2" "$3" <<'PY'
 import sys
-path, old, new = sys.argv[1:]
+path, old, new = (a.replace("\\n", "\n") for a in sys.argv[1:])  # "\n" in a mutant's text: a line break
 text = open(path).read()
 count = text.count(old)
 if count != 1:
