@@ -22,28 +22,17 @@
 #include <thread>
 #include <vector>
 
+#include "cli_runner.hpp"
+
 extern char** environ;
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string tool() {
-  const char* b = std::getenv("NYSTROM_BIN");
-  return b ? b : "nystrom";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using cli_test::Result;
+using cli_test::slurp;
+using cli_test::tool;
 
 // A fresh folder per test: the tool runs there, with TMPDIR pointing to a private folder inside it.
 fs::path work_dir() {
