@@ -267,6 +267,34 @@ TEST(ObservedOrderOutsideTheCatalog, MultiProductSpecifications) {
   }
 }
 
+// Adjoints (`adjoint:NAME`, the sub-steps reversed). The declared order of an adjoint is copied from its
+// base; here it is measured instead. The adjoint of a method of order p has order p (Hairer, Lubich,
+// Wanner, Geometric Numerical Integration, 2nd ed., Thm. II.3.1; Gürkan, Table 4.1 and 4.2 captions: "the
+// adjoint methods are also valid"), so the expected orders below are the base methods' published orders,
+// written out here, not read from the catalog. Non-symmetric real methods (AR1, BR2, BR3: the adjoint is
+// another method; for AR1 and BR2 an adjoint that is not a true reversal is not even consistent), a
+// symmetric one (KL8: the adjoint is the method itself), and complex ones (AC1, BC1: the adjoint is the
+// complex conjugate; Chambers), with the acceptance rule of the catalog order test.
+TEST(ObservedOrderOutsideTheCatalog, AdjointSpecifications) {
+  for (const auto& [spec, order] : std::vector<std::pair<std::string, int>>{{"adjoint:AR1", 5},
+                                                                            {"adjoint:BR2", 5},
+                                                                            {"adjoint:BR3", 5},
+                                                                            {"adjoint:KL8", 8},
+                                                                            {"adjoint:AC1", 5},
+                                                                            {"adjoint:BC1", 5},
+                                                                            {"adjoint:Chambers", 3}}) {
+    const MethodDef def = resolve_method(spec);
+    ASSERT_EQ(def.info.order, order) << spec;
+    const auto m = measure_catalog_order(def);
+    std::cout << "[ order    ] " << std::left << std::setw(16) << spec << " declared " << order << "  observed "
+              << std::fixed << std::setprecision(3) << m.observed << " (" << m.precision << ")" << std::endl;
+    ASSERT_GE(m.points.size(), 2u) << spec << "\n" << m.log();
+    EXPECT_TRUE(m.asymptotic) << spec << "\n" << m.log();
+    EXPECT_TRUE(order_matches(order, m.observed, def.info.complex)) << spec << " shows " << m.observed << "\n"
+                                                                    << m.log();
+  }
+}
+
 // ---- the measurement can fail -----------------------------------------------------------------------
 
 namespace {
