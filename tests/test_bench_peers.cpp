@@ -6,6 +6,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -91,6 +92,35 @@ const std::vector<std::string> kAdaptive{"DP12-adaptive", "M10-adaptive",  "M12-
                                          "M14-adaptive",  "M16-adaptive",  "M12-adaptive (no comp.)",
                                          "GBS",           "odeint dopri5", "odeint bulirsch_stoer"};
 
+// The orders the publications give the fixed-step methods (not read from the tool's JSON): Chin (2010)
+// for the multi-product M<2n> (order 2n), M6-5F and Albrecht's A6; Kahan-Li KL8, Sofroniou-Spaletta SS10,
+// Dormand-El-Mikkawy-Prince DP12; McLachlan's SB3A (4) and Fehlberg 7(8) (stepping with order 8) in odeint.
+// `symplectic`: symmetric symplectic methods, whose error at whole periods is the phase error, of order p.
+struct Published {
+  int order;
+  bool symplectic;
+};
+const std::map<std::string, Published> kPublished{{"VV", {2, true}},
+                                                  {"M4", {4, false}},
+                                                  {"M6", {6, false}},
+                                                  {"M6-5F", {6, false}},
+                                                  {"A6", {6, false}},
+                                                  {"M8", {8, false}},
+                                                  {"KL8", {8, true}},
+                                                  {"M10", {10, false}},
+                                                  {"SS10", {10, true}},
+                                                  {"M12", {12, false}},
+                                                  {"DP12", {12, false}},
+                                                  {"odeint velocity_verlet", {2, true}},
+                                                  {"odeint sb3a_mclachlan", {4, true}},
+                                                  {"odeint sb3a_m4_mclachlan", {4, true}},
+                                                  {"odeint rkf78", {8, false}}};
+// The quick sweep (steps per period refined by sqrt(2) and truncated to integers) leaves these high orders
+// two or three runs between 1e-3 and the round-off floor, with slopes that jump (measured SS10 2.1, 10.9,
+// 20.0, 7.9; M12 9.7, 14.1, 21.4; DP12 7.2, 15.1, 11.5): no asymptotic range, so no order is read
+// from the sweep. Their orders are measured by test_order (all three) and test_dp12.
+const std::set<std::string> kNoAsymptoticRange{"SS10", "M12", "DP12"};
+
 }  // namespace
 
 TEST_F(BenchPeers, FilesExistAndParse) {
@@ -155,31 +185,57 @@ TEST_F(BenchPeers, FixedStepForceCountsAreStepsTimesForcesPerStep) {
     }
 }
 
-// At e = 0.5 every fixed-step method converges at its order: errors fall strictly with the step count
-// between 1e-3 and 1e-10, and the fitted slope is near the order.
+// At e = 0.5 the errors fall at the order, recomputed here from the runs (the tool's own fitted
+// `observed_order` is not used): the runs in increasing steps per period n while the error lies between
+// 1e-3 (pre-asymptotic) and 3e-11 (the round-off floor of double over 100 periods lies at 1e-12..5e-12;
+// below 3e-11 the slopes bend); the slope between consecutive runs is log(err_i/err_i+1)/log(n_i+1/n_i)
+// with the steps actually taken. A slope counts once it agrees within 0.15 with the one before it (two
+// consecutive slopes: the asymptotic range); the last such slope is asserted.
+//   * Symmetric symplectic methods: within 0.35 of the order p (measured VV 2.00, KL8 8.00, odeint
+//     velocity_verlet 2.00, SB3A 3.90 and 3.82, bending towards the floor after a run of 4.00).
+//   * The others, within 0.35 of the interval [p, p + 1]: the error after 100 whole periods is a part of
+//     order p that does not grow (it vanishes where the leading error term is removable by a change of
+//     coordinates) plus a secular part t h^(p+1) (t = 200 pi), so over the range double precision can see
+//     the slope moves from p + 1 towards p (measured M4 4.83 ... 4.25, M6 6.83, M6-5F 6.80, A6 6.89, M8 8.92,
+//     M10 10.88, odeint rkf78 8.92). A method of the wrong order by two or more fails; test_order measures
+//     every catalog order within 0.35 away from whole periods.
 TEST_F(BenchPeers, FixedStepErrorsFallAtTheOrder) {
   std::vector<std::string> all = kNystromFixed;
   all.insert(all.end(), kOdeintFixed.begin(), kOdeintFixed.end());
+  int asserted = 0;
   for (const auto& label : all) {
-    const auto runs = runs_of(label, 0.5);
-    double prev = INFINITY;
-    int used = 0;
+    ASSERT_EQ(kPublished.count(label), 1u) << label;
+    const Published pub = kPublished.at(label);
+    auto runs = runs_of(label, 0.5);
+    std::sort(runs.begin(), runs.end(),
+              [](const json& a, const json& b) { return a["steps"].get<long>() < b["steps"].get<long>(); });
+    std::vector<double> n, err;
     for (const auto& r : runs) {
-      const double err = r["error"].is_null() ? INFINITY : r["error"].get<double>();
-      if (err > 1e-3 || err < 1e-10) continue;
-      EXPECT_LT(err, prev) << label << " at " << r["param"] << " steps per period";
-      prev = err;
-      ++used;
-    }
-    EXPECT_GE(used, 2) << label;
-    for (const auto& m : (*j_)["methods"])
-      if (m["label"] == label && m["ecc"].get<double>() == 0.5) {
-        ASSERT_FALSE(m["observed_order"].is_null()) << label;
-        const double p = m["observed_order"].get<double>(), order = m["order"].get<double>();
-        EXPECT_GT(p, 0.8 * order) << label;
-        EXPECT_LT(p, 1.6 * order + 0.5) << label;
+      const double e = r["error"].is_null() ? INFINITY : r["error"].get<double>();
+      if (e > 1e-3) continue;
+      if (e < 3e-11) break;
+      if (!err.empty()) {
+        EXPECT_LT(e, err.back()) << label << " at " << r["param"] << " steps per period";
       }
+      n.push_back(static_cast<double>(r["steps"].get<long>()));
+      err.push_back(e);
+    }
+    if (kNoAsymptoticRange.count(label)) continue;
+    std::vector<double> slopes;
+    std::ostringstream log;
+    for (std::size_t i = 0; i + 1 < n.size(); ++i) {
+      slopes.push_back(std::log(err[i] / err[i + 1]) / std::log(n[i + 1] / n[i]));
+      log << " n=" << n[i + 1] << " err=" << err[i + 1] << " slope=" << slopes.back() << ";";
+    }
+    double settled = NAN;
+    for (std::size_t i = 1; i < slopes.size(); ++i)
+      if (std::abs(slopes[i] - slopes[i - 1]) < 0.15) settled = slopes[i];
+    ASSERT_FALSE(std::isnan(settled)) << label << ": no two consecutive slopes agree:" << log.str();
+    EXPECT_GT(settled, pub.order - 0.35) << label << ":" << log.str();
+    EXPECT_LT(settled, pub.order + (pub.symplectic ? 0 : 1) + 0.35) << label << ":" << log.str();
+    ++asserted;
   }
+  EXPECT_EQ(asserted, static_cast<int>(all.size() - kNoAsymptoticRange.size()));
 }
 
 // Adaptive methods: tighter tolerances cost more and end closer.
