@@ -1,11 +1,20 @@
 // `nystrom reproduce all --quick`: every target writes its CSV, PNG and JSON, the report and summary.json,
 // and the claims the papers make in words hold. The tool is found through NYSTROM_BIN (set by CTest).
-// Besides the tool's own verdicts, the key comparisons are recomputed here from the CSV files.
+// The tool's own verdicts (summary.json) are checked for consistency only; what makes the test is the
+// comparison, recomputed here from the CSV files, of the tool's numbers with the values the papers print,
+// written out below with the table, figure or passage they come from:
+//   S. A. Chin, "Multi-product splitting and Runge-Kutta-Nystrom integrators", Celest. Mech. Dyn. Astron.
+//     106 (2010) 391 (sec. III-V, Figs. 1-3);
+//   M. A. Gurkan, "Fifth order Runge-Kutta-Nystrom methods with complex coefficients" (preprint, 2012;
+//     Table 4.3, sec. 5, Figs. 5.1-5.2).
+// The published values in the tool's CSV files are compared with these too (a mistyped published value in
+// the tool fails), and the orders of Fig. 5.1 are measured against theory.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -140,32 +149,50 @@ void check_chin_fig1(const fs::path& out) {
     ADD_FAILURE() << "no row for " << m << " at e = " << e;
     return std::nan("");
   };
-  // Signs as published (FR, A', M4 negative; N positive), M4 the smallest at e = 0.9.
-  EXPECT_LT(eP("FR", 0.9), 0);
-  EXPECT_GT(eP("N4", 0.9), 0);
-  EXPECT_LT(eP("Aprime", 0.9), 0);
-  EXPECT_LT(eP("M4", 0.9), 0);
-  for (const char* m : {"FR", "N4", "Aprime"}) EXPECT_LT(std::abs(eP("M4", 0.9)), std::abs(eP(m, 0.9))) << m;
-  // Steep growth with e: more than three decades from e = 0.4 to 0.9 for every method.
-  for (const char* m : {"FR", "N4", "Aprime", "M4"}) EXPECT_GT(std::abs(eP(m, 0.9) / eP(m, 0.4)), 1e3) << m;
+  // Chin, sec. III (text on Fig. 1): "The error coefficient e_P at e = 0.9 for FR, N, A' and M4 are -23.1 x 10^4,
+  // 7.1 x 10^4, -1.4 x 10^4 and -1.1 x 10^4", computed at h = 2 pi/5000 ("the final value used"), the step of the
+  // rows read here. Printed to 0.1 x 10^4: each must agree within half that unit.
+  const std::map<std::string, double> printed{{"FR", -23.1e4}, {"N4", 7.1e4}, {"Aprime", -1.4e4}, {"M4", -1.1e4}};
+  for (const auto& [m, p] : printed) EXPECT_NEAR(eP(m, 0.9), p, 0.05e4 * (1 + 1e-9)) << m;
+  // "The coefficient e_P grows steeply with e, by four orders of magnitude from e = 0.4 to e = 0.9" (one
+  // significant digit): log10 |e_P(0.9)/e_P(0.4)| within [3.5, 4.5] for every method.
+  for (const auto& [m, p] : printed) {
+    const double decades = std::log10(std::abs(eP(m, 0.9) / eP(m, 0.4)));
+    EXPECT_GE(decades, 3.5) << m;
+    EXPECT_LE(decades, 4.5) << m;
+  }
+}
+
+/// `ratio` compared with a value the paper gives in words ("about", "nearly", "comparable"), read off its
+/// log-log figures: within a factor 2 either way. This is the text's precision, not a property of the
+/// method: a method of the wrong order is caught by the slopes below and by test_order.
+void expect_about(double ratio, double printed, const std::string& what) {
+  EXPECT_GT(ratio, printed / 2) << what << ": published " << printed << ", measured " << ratio;
+  EXPECT_LT(ratio, printed * 2) << what << ": published " << printed << ", measured " << ratio;
 }
 
 void check_chin_fig2_and_3(const fs::path& out) {
   const auto f2 = read_csv(out / "chin-fig2.csv");
-  // At N = 1e5: KL6 better than Y6, both symplectic methods worse than the RKN methods A6 and M6.
-  EXPECT_LT(error_at(f2, "KL6", 1e5), error_at(f2, "Y6", 1e5));
+  // Chin, sec. V (text on Fig. 2), at N = 10^5 force evaluations, e = 0.9: "KL6's error is only half of Y6's",
+  // "their respective error are nearly 50 and 100 times larger than those of RKN integrators A6 and M6".
+  const double y6 = error_at(f2, "Y6", 1e5), kl6 = error_at(f2, "KL6", 1e5);
+  expect_about(kl6 / y6, 0.5, "KL6/Y6");
   for (const char* r : {"A6", "M6"}) {
-    for (const char* s : {"KL6", "Y6"}) {
-      EXPECT_LT(10 * error_at(f2, r, 1e5), error_at(f2, s, 1e5)) << r << " vs " << s;
-    }
+    expect_about(kl6 / error_at(f2, r, 1e5), 50, std::string("KL6/") + r);
+    expect_about(y6 / error_at(f2, r, 1e5), 100, std::string("Y6/") + r);
   }
   const auto f3 = read_csv(out / "chin-fig3.csv");
-  // At N = 1e5: KL8 and SS10 far worse than M8 and M10; DP12 beats M12, and M14 beats DP12.
-  EXPECT_LT(10 * error_at(f3, "M8", 1e5), error_at(f3, "KL8", 1e5));
-  EXPECT_LT(10 * error_at(f3, "M10", 1e5), error_at(f3, "SS10", 1e5));
-  EXPECT_LT(error_at(f3, "DP12", 1e5), error_at(f3, "M12", 1e5));
+  // Chin, sec. V (text on Fig. 3), at N = 10^5: "the error of KL8 is more than 300 times that of" M8; "the error
+  // of SS10 ... is about 100 times that of" M10; "DP10 is comparable to 10"; "DP12's error ... is 10 times smaller
+  // than 12"; M14's error "is then 100 times smaller than DP12".
+  EXPECT_GT(error_at(f3, "KL8", 1e5) / error_at(f3, "M8", 1e5), 300.0);
+  expect_about(error_at(f3, "SS10", 1e5) / error_at(f3, "M10", 1e5), 100, "SS10/M10");
+  expect_about(error_at(f3, "DP10", 1e5) / error_at(f3, "M10", 1e5), 1, "DP10/M10");
+  expect_about(error_at(f3, "M12", 1e5) / error_at(f3, "DP12", 1e5), 10, "M12/DP12");
+  // M14 beating DP12 "100 times" is not reproduced (measured 28 at N = 10^5; the report says so): only the
+  // direction is asserted.
   EXPECT_LT(error_at(f3, "M14", 1e5), error_at(f3, "DP12", 1e5));
-  // The best MPE order rises with N (the envelope is not a fixed order).
+  // "The enveloping error curve is steeper than any fixed order integrator": the best order rises with N.
   auto best = [&](double n) {
     std::string m;
     double e = INFINITY;
@@ -197,55 +224,85 @@ std::vector<double> steps_of(const std::vector<std::map<std::string, std::string
 
 void check_gurkan(const fs::path& out) {
   {
-    // Table 4.3: every norm within one unit of the third printed digit; the complex methods' X_i purely imaginary,
-    // the real methods' real; every |X_i| within one unit of the second printed digit.
+    // Gurkan, Table 4.3 (coefficients of H - Z in degree 6 and their norm), as printed: two significant digits
+    // for X11, X16, X17, X19, X20 (real for Table 4.1's methods, purely imaginary for Table 4.2's), three for
+    // the norm. The tool's published columns must be these; its computed values (17 digits) must round to
+    // them: within half a unit of the last printed digit. The AC2 row is printed with the signs of AC2's
+    // adjoint (its complex conjugate; test_bch, ReproducesGurkanTable43), so its terms are compared with the
+    // signs reversed.
+    struct Printed {
+      std::vector<double> x;
+      double norm;
+      bool imaginary;
+    };
+    const std::map<std::string, Printed> table{{"AR1", {{-3.1e-3, 4.5e-4, 5.6e-3, 1.8e-5, -6.3e-5}, 6.44e-3, false}},
+                                               {"AR2", {{5.0e-3, -3.1e-4, -5.7e-3, 1.5e-5, 2.5e-4}, 7.58e-3, false}},
+                                               {"BR1", {{1.5e-4, 6.2e-5, -4.1e-4, 5.7e-5, 1.6e-4}, 4.71e-4, false}},
+                                               {"BR2", {{-7.0e-5, 9.7e-4, 2.7e-4, 5.2e-4, 5.2e-4}, 1.25e-3, false}},
+                                               {"BR3", {{3.5e-2, 1.9e-4, -3.5e-2, -3.0e-5, -1.0e-4}, 4.90e-2, false}},
+                                               {"AC1", {{-2.5e-6, 7.3e-6, -5.0e-6, 8.3e-7, 4.2e-6}, 1.02e-5, true}},
+                                               {"AC2", {{3.0e-6, -7.9e-6, 6.0e-6, -9.4e-7, -4.7e-6}, 1.15e-5, true}},
+                                               {"BC1", {{1.2e-5, -1.3e-5, 8.4e-6, 2.2e-7, -4.2e-6}, 1.96e-5, true}},
+                                               {"BC2", {{-4.1e-5, 4.9e-5, -1.2e-4, 7.7e-6, 5.0e-5}, 1.49e-4, true}}};
+    const std::vector<std::string> terms{"X11", "X16", "X17", "X19", "X20"};
+    auto half_unit = [](double printed, int digits) {
+      return 0.5 * std::pow(10.0, std::floor(std::log10(std::abs(printed))) - digits + 1) * (1 + 1e-9);
+    };
     const auto rows = read_csv(out / "gurkan-table4.3.csv");
-    std::set<std::string> methods;
-    int norms = 0;
+    std::map<std::string, int> seen;
     for (const auto& r : rows) {
-      methods.insert(r.at("method"));
+      const std::string m = r.at("method"), term = r.at("term");
+      ASSERT_EQ(table.count(m), 1u) << m;
+      const Printed& p = table.at(m);
       const double pre = std::stod(r.at("published_re")), pim = std::stod(r.at("published_im"));
       const double cre = std::stod(r.at("computed_re")), cim = std::stod(r.at("computed_im"));
-      const double pub = pim != 0 ? pim : pre, got = pim != 0 ? cim : cre, other = pim != 0 ? cre : cim;
-      const int digits = std::stoi(r.at("printed_digits"));
-      const double unit = std::pow(10.0, std::floor(std::log10(std::abs(pub))) - digits + 1);
-      EXPECT_LE(std::abs(std::abs(got) - std::abs(pub)), 1.5 * unit) << r.at("method") << " " << r.at("term");
-      EXPECT_LE(std::abs(other), 1e-9 * std::abs(got)) << r.at("method") << " " << r.at("term");
-      if (r.at("term") == "norm") {
-        ++norms;
-        EXPECT_LE(std::abs(got - pub), 1.5 * unit) << r.at("method");
+      ++seen[m];
+      if (term == "norm") {
+        EXPECT_EQ(pre, p.norm) << m << ": the tool's published norm";
+        EXPECT_NEAR(cre, p.norm, half_unit(p.norm, 3)) << m << " norm";
+        continue;
       }
+      const auto k = static_cast<std::size_t>(std::find(terms.begin(), terms.end(), term) - terms.begin());
+      ASSERT_LT(k, terms.size()) << m << " " << term;
+      const double want = p.x[k];
+      EXPECT_EQ(p.imaginary ? pim : pre, want) << m << " " << term << ": the tool's published value";
+      EXPECT_EQ(p.imaginary ? pre : pim, 0.0) << m << " " << term << ": the tool's published value";
+      const double got = (m == "AC2" ? -1 : 1) * (p.imaginary ? cim : cre), other = p.imaginary ? cre : cim;
+      EXPECT_NEAR(got, want, half_unit(want, 2)) << m << " " << term;
+      EXPECT_LE(std::abs(other), 1e-9 * std::abs(got)) << m << " " << term;
     }
-    EXPECT_EQ(methods.size(), 9u);
-    EXPECT_EQ(norms, 9);
+    EXPECT_EQ(seen.size(), table.size());
+    for (const auto& [m, n] : seen) EXPECT_EQ(n, 6) << m;
   }
   {
-    // Fig. 5.1: errors shrink with h; the optimized fourth-order RKNb6 beats the fifth-order RKNbr1 above the
-    // rounding floor; Chambers (third order) and RKNac1 (fifth) decrease faster than their formal orders predict.
+    // Fig. 5.1 (two-body problem, e = 0.2): the interquartile range of the error made in one step, i.e. the
+    // local error, of order p + 1 for a method of order p. Expected slopes against h: leapfrog 3, Y4 and
+    // RKNb6 5, RKNa14 7, BR1 6; Chambers 5 and AC1 7, one more than their formal orders 3 and 5 because the
+    // imaginary parts are dropped (sec. 5: "Chambers shows fourth order and method AC1 shows sixth order
+    // behaviour"). The quick grid has three steps, h = 0.01, 10^-1.5, 0.1 periods; the slope between the two
+    // smallest must lie within 0.35 of the expected one (measured: 3.00, 5.25, 4.97, 6.98, 6.03, 5.01, 6.98).
     const auto rows = read_csv(out / "gurkan-fig5.1.csv");
     const auto hs = steps_of(rows);
-    ASSERT_GE(hs.size(), 2u);
-    for (const char* m : {"VV", "Y4", "Chambers", "RKNb6", "RKNa14", "BR1", "AC1"})
-      EXPECT_LT(iqr_at(rows, m, hs.front()), iqr_at(rows, m, hs.back())) << m;
+    ASSERT_EQ(hs.size(), 3u);
+    const std::map<std::string, double> local_order{{"VV", 3},  {"Y4", 5},  {"RKNb6", 5},   {"RKNa14", 7},
+                                                    {"BR1", 6}, {"AC1", 7}, {"Chambers", 5}};
+    for (const auto& [m, p] : local_order) {
+      const double slope = std::log(iqr_at(rows, m, hs[1]) / iqr_at(rows, m, hs[0])) / std::log(hs[1] / hs[0]);
+      EXPECT_NEAR(slope, p, 0.35) << m;
+    }
+    // "RKNb6 outperforms a method of higher order, RKNbr1, down to machine accuracy level".
     for (double h : hs) {
       if (iqr_at(rows, "BR1", h) > 1e-13) {
         EXPECT_LT(iqr_at(rows, "RKNb6", h), iqr_at(rows, "BR1", h)) << h;
       }
     }
-    const double h0 = hs[hs.size() - 2], h1 = hs.back();
-    const double slope_ch = std::log(iqr_at(rows, "Chambers", h1) / iqr_at(rows, "Chambers", h0)) / std::log(h1 / h0);
-    EXPECT_GT(slope_ch, 4.5);  // local error O(h^{p+1}) with p = 4 > 3
-    const double slope_vv = std::log(iqr_at(rows, "VV", h1) / iqr_at(rows, "VV", h0)) / std::log(h1 / h0);
-    EXPECT_GT(slope_vv, 2.5);
-    EXPECT_LT(slope_vv, 3.5);
   }
   {
-    // Fig. 5.2: Triple jump nearly coincides with Chambers for the 400-body problem.
+    // Fig. 5.2 caption: Triple jump "nearly coincides with Chambers for this problem" (the 400-body problem;
+    // measured ratios 0.92 and 0.74).
     const auto rows = read_csv(out / "gurkan-fig5.2.csv");
     for (double h : steps_of(rows)) {
-      const double q = iqr_at(rows, "Y4", h) / iqr_at(rows, "Chambers", h);
-      EXPECT_GT(q, 1.0 / 3) << h;
-      EXPECT_LT(q, 3.0) << h;
+      expect_about(iqr_at(rows, "Y4", h) / iqr_at(rows, "Chambers", h), 1, "Y4/Chambers at h = " + std::to_string(h));
     }
   }
 }
