@@ -63,11 +63,13 @@ struct SolveOptions {
   /// (atol 0: atol = rtol).
   double rtol = 0;
   double atol = 0;
-  /// Output times, monotone in the direction of integration, within the span (from the dense output).
-  /// Empty: the state at every step end (and at t0).
+  /// Output times, monotone in the direction of integration, within the span (by partial steps of the
+  /// method, as sol(t); their forces are counted in output_force_evals). Empty: the state at every step
+  /// end (and at t0).
   std::vector<double> t_eval{};
-  /// Keep every step end for sol(t) (one force evaluation per step end where the method does not
-  /// provide it; counted in output_force_evals).
+  /// Keep every step end, and a copy of the method and force, for sol(t) (solve/dense.hpp): one force
+  /// evaluation per step end for the Hermite interpolant, counted in output_force_evals. Output times
+  /// and events do not need it.
   bool dense = true;
   /// The largest number of steps (accepted and rejected).
   long max_steps = 10000000;
@@ -768,8 +770,16 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
   const R span = sgn_mul(dir, R(prob.t1 - prob.t0));
   State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
   R t_start = prob.t0;
-  // The partial steps run a fresh copy of the integrator (its controller in the initial state).
-  Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir, run.partial_step(g));
+  // The partial steps run a fresh copy of the integrator (its controller in the initial state) at a
+  // tolerance 1000 times smaller (bounded by rounding): GBS's accepted steps are usually far more
+  // accurate than its tolerance (the estimate is that of the column before the accepted one), and a
+  // partial step must not be less accurate than the steps it lies between.
+  GbsOptions gp = go;
+  gp.rtol = std::max(go.rtol * 1e-3, 100 * as_double(epsilon_of<R>()));
+  gp.atol = std::max(go.atol * 1e-3, 100 * as_double(epsilon_of<R>()));
+  Recorder<V, SecondOrderProblem<V, F>> rec(
+      prob, run.opt, events, sol, dir,
+      run.partial_step(GbsIntegrator<VE, typename Run<V, F, VE>::Force>(run.force(), gp)));
   if (resume) {
     if (resume->engine != "gbs") throw invalid_input("checkpoint of another engine (" + resume->engine + ")");
     run.restore(*resume, s);
