@@ -112,7 +112,7 @@ SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq,
   else
     opt.steps = req.steps_per_period * req.periods;
   opt.engine.keep_complex = req.keep_complex;
-  opt.dense = false;  // the output times and events use the step ends' interpolants as they go
+  opt.dense = false;  // output times and events are taken as the run goes (partial steps of the method)
   if (!sreq.output_times.empty()) opt.t_eval = parse_output_times(sreq.output_times);
   for (double t : opt.t_eval)
     if (t < 0 || t > t_end)

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -45,7 +46,11 @@ TEST(CliSolve, OutputTimesComeFromTheDenseOutput) {
     worst = std::max(worst, std::hypot(p["q"][0].get<double>() - ex.q[0], p["q"][1].get<double>() - ex.q[1]));
     EXPECT_NEAR(p["v"][0].get<double>(), ex.v[0], 1e-6);
   }
-  EXPECT_LT(worst, 1e-7);  // M8 at 200 steps per period: the step-end error is about 1e-9
+  // The output points are as accurate as the method: within 10x of its error at the end of the run (the
+  // global error grows with time, and the last output time lies just before the end).
+  const double end_err = j.at("position_error").get<double>();
+  EXPECT_GT(end_err, 0.0);
+  EXPECT_LE(worst, 10 * end_err) << "end of the run " << end_err;
   EXPECT_EQ(j.at("q").size(), 2u);
 }
 
@@ -63,12 +68,30 @@ TEST(CliSolve, PericentreApocentreAndAxisCrossingEvents) {
     ASSERT_EQ(e["v"].size(), 2u);
   }
   ASSERT_EQ(peri.size(), 3u);
-  // The event times come from the dense output between the adaptive steps (quintic Hermite).
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(peri[i], (2 * i + 1) * pi, 1e-4);
-  // 2 pi and 4 pi; 6 pi is the end of the span, where r.v = 0 up to rounding (found or not).
+  // The method's accuracy, from the state at the end of the run (an apocentre, at 6 pi): the error of a
+  // Kepler orbit is mostly a shift along it, whose time is dq / |v| there; it grows with time, so the
+  // earlier passages are shifted less. A located pericentre lies within twice that shift of the analytic
+  // time (plus a few ulps of t), and within the contract's 1e-12 relative.
+  const nystrom::KeplerProblem<double> kp(0.9);
+  const auto ex = kp.exact(6 * pi);
+  const double dq = std::hypot(j["q"][0].get<double>() - ex.q[0], j["q"][1].get<double>() - ex.q[1]);
+  const double dv = std::hypot(j["v"][0].get<double>() - ex.v[0], j["v"][1].get<double>() - ex.v[1]);
+  const double va = std::hypot(ex.v[0], ex.v[1]), ra = std::hypot(ex.q[0], ex.q[1]);
+  const double eps = std::numeric_limits<double>::epsilon();
+  for (int i = 0; i < 3; ++i) {
+    const double ts = (2 * i + 1) * pi;
+    EXPECT_NEAR(peri[i], ts, 2 * dq / va + 8 * eps * ts);
+    EXPECT_LE(std::abs(peri[i] - ts), 1e-12 * ts);
+  }
+  // 2 pi and 4 pi; 6 pi is the end of the span, where r.v = 0 up to rounding (found or not). At an
+  // apocentre g = r.v moves by at most |v| dq + r dv with g' = |v|^2 - 1/r.
   ASSERT_GE(apo.size(), 2u);
   ASSERT_LE(apo.size(), 3u);
-  for (int i = 0; i < 2; ++i) EXPECT_NEAR(apo[i], 2 * (i + 1) * pi, 1e-4);
+  const double gdot = std::abs(va * va - 1 / ra);
+  for (int i = 0; i < 2; ++i) {
+    const double ts = 2 * (i + 1) * pi;
+    EXPECT_NEAR(apo[i], ts, 2 * (va * dq + ra * dv) / gdot + 8 * eps * ts);
+  }
   // The x axis is crossed at every pericentre and apocentre.
   EXPECT_GE(axis.size(), 5u);
   EXPECT_LE(axis.size(), 6u);

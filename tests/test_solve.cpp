@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -194,89 +195,95 @@ TEST(Solve, AForceReturningNaNIsReportedWithTheTime) {
   }
 }
 
-TEST(SolveDense, InteriorErrorWithinTenTimesTheStepEndErrorUpToOrderEight) {
-  // Kepler e = 0.5 over one period, about 2000 forces per period for every method; the largest position
-  // error at 100 points inside each step against the largest error at the step ends.
-  const KeplerProblem<double> kp(0.5);
-  const double T = 2 * pi;
-  const auto prob = kepler(0.5, 0.0, T);
-  int tested = 0;
-  for (const auto& def : catalog()) {
-    if (def.info.adaptive || def.info.order <= 0) continue;
-    SCOPED_TRACE(def.info.name);
-    const long steps = std::max(20L, 2000L / std::max(1, def.info.forces_per_step));
-    const auto sol = solve(prob, def, {.steps = steps});
-    double end_err = 0, mid_err = 0;
-    for (std::size_t k = 0; k < sol.t.size(); ++k) end_err = std::max(end_err, pos_err(sol.q[k], kp.exact(sol.t[k])));
-    for (std::size_t k = 0; k + 1 < sol.t.size(); ++k)
-      for (int j = 1; j <= 100; ++j) {
-        const double t = sol.t[k] + (sol.t[k + 1] - sol.t[k]) * j / 101.0;
-        mid_err = std::max(mid_err, pos_err(sol(t).q, kp.exact(t)));
-      }
-    if (def.info.order <= 6) {
-      // RKNa14 (14 stages, small error constant) measured 24x: its step-end error 4e-11 is near the
-      // interpolant's 1e-9 at 143 steps per period.
-      const double factor = def.info.name == "RKNa14" ? 30 : 10;
-      EXPECT_LE(mid_err, factor * end_err) << "step ends " << end_err << ", inside " << mid_err;
-      ++tested;
-    } else {
-      // Order > 6: the quintic Hermite interpolant (order 6) limits sol(t) between step ends. Measured
-      // here (about 2000 forces per period): M8 2e-13 at the step ends, 1.3e-10 inside; KL8 1e-11 and
-      // 3e-9; RKNa14 4e-11 and 1e-9; M10-M16, SS10, DP10, DP12 1e-15..4e-13 and 1e-9..3e-7.
-      EXPECT_LT(mid_err, 1e-6);
-      std::printf("dense output %-10s order %2d: step ends %.2e, inside %.2e\n", def.info.name.c_str(), def.info.order,
-                  end_err, mid_err);
-    }
-  }
-  EXPECT_GT(tested, 15);
+namespace {
+
+// How far the located time of a zero of g = r.v (a pericentre or apocentre of Kepler) may lie from the
+// analytic time ts, given the method's accuracy there: the error of sol(ts) (dq in position, dv in
+// velocity) shifts g by at most |v| dq + r dv, and g' = |v|^2 - 1/r, so the zero moves by at most that
+// over |g'|; twice that, plus the rounding of the time (a few ulps of ts).
+double apsis_time_bound(const Solution<V2>& sol, const KeplerProblem<double>& kp, double ts) {
+  const auto ex = kp.exact(ts);
+  const auto s = sol(ts);
+  const double dq = std::hypot(s.q[0] - ex.q[0], s.q[1] - ex.q[1]);
+  const double dv = std::hypot(s.v[0] - ex.v[0], s.v[1] - ex.v[1]);
+  const double r = std::hypot(ex.q[0], ex.q[1]), v = std::hypot(ex.v[0], ex.v[1]);
+  const double gdot = std::abs(v * v - 1 / r);
+  return 2 * (v * dq + r * dv) / gdot + 8 * std::numeric_limits<double>::epsilon() * ts;
 }
 
-TEST(SolveEvents, KeplerPericentreAndApocentrePassagesAreTheAnalyticOnes) {
+const std::vector<Event<V2>> apsides = {
+    {"pericentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, +1, false},
+    {"apocentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, -1, false},
+};
+
+}  // namespace
+
+TEST(SolveEvents, KeplerApsidesAreTheAnalyticOnesToTheMethodsAccuracy) {
   // From the apocentre, r.v < 0 until the pericentre at t = pi (mod 2 pi), where it turns positive.
-  const auto prob = kepler(0.5, 0.0, 6 * pi - 0.5);  // not ending on an apocentre (g = 0 there)
-  const std::vector<Event<V2>> ev = {
-      {"pericentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, +1, false},
-      {"apocentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, -1, false},
+  // e = 0.9, to just before 6 pi (not ending on an apocentre, where g = 0).
+  const KeplerProblem<double> kp(0.9);
+  const auto prob = kepler(0.9, 0.0, 6 * pi - 0.5);
+  struct Case {
+    std::string method;
+    SolveOptions opt;
+    bool target;  // accurate enough for the times to 1e-12 relative
   };
-  for (const std::string m : {"DP12-adaptive", "M14-adaptive", "GBS", "M8"}) {
-    SCOPED_TRACE(m);
-    // The adaptive steps are bounded (h_max) so that the dense output between them is accurate; GBS's
-    // steps (about 1 here) leave the quintic interpolant at 1e-3 in time.
-    SolveOptions o{.steps = 3000, .rtol = 1e-13};
-    o.adaptive.h_max = 0.02;
-    const auto sol = solve(prob, m, o, ev);
+  const std::vector<Case> cases = {{"DP12-adaptive", {.rtol = 1e-12}, true},
+                                   {"M8", {.steps = 60000}, true},
+                                   {"M14-adaptive", {.rtol = 1e-12}, true},
+                                   {"GBS", {.rtol = 1e-12}, false},
+                                   {"M6", {.steps = 6000}, false}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.method);
+    const auto sol = solve(prob, c.method, c.opt, apsides);
     std::vector<double> peri, apo;
     for (const auto& e : sol.events) (e.name == "pericentre" ? peri : apo).push_back(e.t);
     ASSERT_EQ(peri.size(), 3u);
     ASSERT_EQ(apo.size(), 2u);  // 2 pi and 4 pi
-    // The located times are those of the dense output (quintic Hermite between step ends): for the
-    // fixed-step M8 it is the method's accuracy, for the large steps of the adaptive methods the
-    // interpolant's.
-    const double tol = m == "M8" ? 1e-11 : m == "GBS" ? 1e-3 : 1e-8;
-    for (int i = 0; i < 3; ++i) EXPECT_NEAR(peri[i], (2 * i + 1) * pi, tol * (2 * i + 1) * pi);
-    for (int i = 0; i < 2; ++i) EXPECT_NEAR(apo[i], 2 * (i + 1) * pi, tol * 2 * (i + 1) * pi);
-    for (int i = 0; i < 3; ++i)
-      std::printf("%s pericentre %d: t - (2i+1) pi = %.2e\n", m.c_str(), i, peri[i] - (2 * i + 1) * pi);
+    for (int i = 0; i < 3; ++i) {
+      const double ts = (2 * i + 1) * pi, bound = apsis_time_bound(sol, kp, ts);
+      EXPECT_NEAR(peri[i], ts, bound);
+      if (c.target) {
+        EXPECT_LE(std::abs(peri[i] - ts), 1e-12 * ts);
+      }
+      std::printf("%-14s pericentre %d: t/pi - %d = %9.2e (bound from the state error %.2e)\n", c.method.c_str(), i,
+                  2 * i + 1, peri[i] / pi - (2 * i + 1), bound / pi);
+    }
+    for (int i = 0; i < 2; ++i) {
+      const double ts = 2 * (i + 1) * pi;
+      EXPECT_NEAR(apo[i], ts, apsis_time_bound(sol, kp, ts));
+    }
   }
 }
 
 TEST(SolveEvents, TerminalEventEndsTheRunThere) {
+  const KeplerProblem<double> kp(0.9);
   const auto prob = kepler(0.9, 0.0, 20.0);
-  const std::vector<Event<V2>> ev = {
-      {"pericentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, +1, true}};
-  SolveOptions o{.rtol = 1e-13};
-  o.adaptive.h_max = 0.01;
-  const auto sol = solve(prob, "DP12-adaptive", o, ev);
+  const std::vector<Event<V2>> ev = {apsides[0]};
+  std::vector<Event<V2>> terminal = ev;
+  terminal[0].terminal = true;
+  const auto sol = solve(prob, "DP12-adaptive", {.rtol = 1e-13}, terminal);
   EXPECT_EQ(sol.status, SolveStatus::terminated_by_event);
-  // At the pericentre of e = 0.9 the speed is 4.36: 1.5e-7 in y measured, from 3e-8 in time.
-  EXPECT_NEAR(sol.t_final, pi, 1e-7);
-  EXPECT_NEAR(sol.q_final[0], -0.1, 1e-7);  // the pericentre of e = 0.9 at (-(1 - e), 0)
-  EXPECT_NEAR(sol.q_final[1], 0.0, 1e-6);
-  EXPECT_EQ(sol.events.size(), 1u);
+  ASSERT_EQ(sol.events.size(), 1u);
+  // The same run without the terminal flag takes the same steps up to there and finds the same time.
+  const auto full = solve(prob, "DP12-adaptive", {.rtol = 1e-13}, ev);
+  ASSERT_GE(full.events.size(), 1u);
+  EXPECT_EQ(full.events[0].t, sol.t_final);
+  EXPECT_NEAR(sol.t_final, pi, apsis_time_bound(full, kp, pi));
+  // The final state is the event's, and the dense output ends there.
+  EXPECT_EQ(sol.q_final, sol.events[0].q);
+  EXPECT_EQ(sol.dense.times().back(), sol.t_final);
   EXPECT_LE(sol.t.back(), sol.t_final);
+  // The pericentre of e = 0.9 lies at (-(1 - e), 0), reached at speed |v| = 4.36: within the state
+  // error of the method there plus |v| times the time error.
+  const auto ex = kp.exact(pi);
+  const auto s = full(pi);
+  const double dq = std::hypot(s.q[0] - ex.q[0], s.q[1] - ex.q[1]) + 4.4 * std::abs(sol.t_final - pi);
+  EXPECT_NEAR(sol.q_final[0], -0.1, 2 * dq + 1e-15);
+  EXPECT_NEAR(sol.q_final[1], 0.0, 2 * dq + 1e-15);
 }
 
-TEST(SolveEvents, HenonHeilesPoincareSectionLiesOnTheSectionAndConservesEnergy) {
+TEST(SolveEvents, HenonHeilesPoincareSectionLiesOnTheSectionAndTheEnergySurface) {
   // H = (px^2 + py^2)/2 + (x^2 + y^2)/2 + x^2 y - y^3/3 at E = 1/8; section x = 0, px > 0.
   VdForce f = [](const Vd& q, Vd& a) {
     a[0] = -q[0] - 2 * q[0] * q[1];
@@ -290,12 +297,28 @@ TEST(SolveEvents, HenonHeilesPoincareSectionLiesOnTheSectionAndConservesEnergy) 
   const double px0 = std::sqrt(2 * E - py0 * py0 - y0 * y0 + 2 * y0 * y0 * y0 / 3);
   const SecondOrderProblem prob(f, Vd{0.0, y0}, Vd{px0, py0}, 0.0, 200.0);
   const std::vector<Event<Vd>> ev = {{"x=0", [](double, const Vd& q, const Vd&) { return q[0]; }, +1, false}};
-  const auto sol = solve(prob, "M8", {.steps = 20000}, ev);
-  ASSERT_GT(sol.events.size(), 20u);
-  for (const auto& e : sol.events) {
-    EXPECT_LT(std::abs(e.q[0]), 1e-12);
-    EXPECT_GT(e.v[0], 0.0);
-    EXPECT_NEAR(energy(e.q, e.v), E, 1e-10);
+  const double eps = std::numeric_limits<double>::epsilon();
+  // M8 at h = 0.1 and h = 0.2: energy errors of about 5e-13 and 1e-10 at the step ends, well above
+  // rounding. A section point is a state of the dense output, so its energy error is bounded by the
+  // method's: within 10x of the largest at the step ends.
+  for (const long steps : {2000L, 1000L}) {
+    SCOPED_TRACE(steps);
+    const auto sol = solve(prob, "M8", {.steps = steps}, ev);
+    double de_ends = 0;
+    for (std::size_t k = 0; k < sol.t.size(); ++k)
+      de_ends = std::max(de_ends, std::abs(energy(sol.q[k], sol.v[k]) - E));
+    EXPECT_GT(de_ends, 100 * eps);
+    ASSERT_GT(sol.events.size(), 20u);
+    double de_section = 0;
+    for (const auto& e : sol.events) {
+      // On the section to the rounding of the located time: |x| <= |px| * (a few ulps of t).
+      EXPECT_LE(std::abs(e.q[0]), 8 * eps * e.t * std::abs(e.v[0]) + eps) << e.t;
+      EXPECT_GT(e.v[0], 0.0);
+      de_section = std::max(de_section, std::abs(energy(e.q, e.v) - E));
+    }
+    EXPECT_LE(de_section, 10 * de_ends);
+    std::printf("Henon-Heiles M8, %ld steps: %zu section points, energy error %.2e (step ends %.2e)\n", steps,
+                sol.events.size(), de_section, de_ends);
   }
 }
 

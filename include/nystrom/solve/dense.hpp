@@ -1,15 +1,25 @@
-// Dense output of a second-order solution: quintic Hermite interpolation between step ends from q,
-// v = q' and a = q'' at both ends (the force at every step end: one evaluation per step). Local error
-// O(h^6) in q and O(h^5) in v, whatever the method. Measured on Kepler e = 0.5 over one period at about
-// 2000 forces per period (tests/test_solve.cpp): within 10x of the step-end error for every catalog
-// method of order <= 6; for order 8 the interpolant's order limits sol(t) between step ends (M8: 2e-13
-// at the step ends, 1.3e-10 inside; KL8 1e-11 and 3e-9; RKNa14 4e-11 and 1e-9), and for orders 10-16
-// (M10-M16, SS10, DP10, DP12) 1e-15..4e-13 at the step ends, 1e-9..3e-7 inside. The step ends keep the
-// method's accuracy; bound the step (AdaptiveOptions::h_max) where sol(t) or events need more.
+// Dense output of a second-order solution: the state at any t of the integrated span.
+//
+// sol(t) continues the solution from the step end before t by one step of the solution's own method
+// with the step size t - t_n (a partial step, as REBOUND lands on output times). Its error is that of
+// the step end t_n plus the local error of a step shorter than the method's, so it keeps the method's
+// order and accuracy whatever the order; it costs one step of the method (its force evaluations) per
+// call. Adaptive RKN pairs and adaptive multi-product methods continue with the fixed-step method they
+// propagate (the high-order weights, or the full multi-product expansion); GBS with a fresh run of the
+// extrapolation integrator over t - t_n at 1/1000 of the solution's tolerances (its accepted steps are
+// usually far more accurate than the tolerance).
+//
+// hermite(t) is the cheap alternative: quintic Hermite interpolation between step ends from q, v and
+// a = q'' at both ends (one force evaluation per step end, none per call). Its local error is O(h^6) in
+// q and O(h^5) in v whatever the method, so it spoils the methods of order 8 and more and the long steps
+// of the adaptive ones: on Kepler e = 0.5 (tests/test_dense.cpp) sol(t) is within 1.2x of the step-end
+// error for every catalog method, the Hermite interpolant 25x to 70x for the order-8 ones (M8, KL8)
+// and 1e6 x between the steps of DP12-adaptive at rtol 1e-10. It is meant for plots.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "nystrom/core/error.hpp"
@@ -48,6 +58,11 @@ template <class V>
 class DenseOutput {
  public:
   using real_type = real_t<typename V::value_type>;
+  /// One step of the solution's method from the step end (t0, q0, v0) to t (t - t0 within the step
+  /// after t0, in the direction of integration): the state at t in q and v; returns the force
+  /// evaluations it took. It must be safe to call concurrently (solve() guards its engine with a mutex).
+  using PartialStep =
+      std::function<long(const real_type& t0, const V& q0, const V& v0, const real_type& t, V& q, V& v)>;
 
   void clear() {
     t_.clear();
@@ -61,50 +76,75 @@ class DenseOutput {
     v_.push_back(v);
     a_.push_back(a);
   }
+  void set_partial_step(PartialStep p) { step_ = std::move(p); }
+  bool has_partial_step() const { return static_cast<bool>(step_); }
   bool empty() const { return t_.empty(); }
   std::size_t size() const { return t_.size(); }
   const std::vector<real_type>& times() const { return t_; }
 
-  /// The state at t (within the span of the stored steps; invalid_input otherwise).
+  /// The state at t (within the span of the stored steps; invalid_input otherwise): a partial step of
+  /// the method from the step end before t, or hermite(t) where no method was kept.
   State<V> operator()(const real_type& t) const {
-    if (t_.empty()) throw invalid_input("no dense output was kept (SolveOptions::dense)");
-    const bool fwd = t_.back() >= t_.front();
-    const real_type lo = fwd ? t_.front() : t_.back(), hi = fwd ? t_.back() : t_.front();
-    if (!(t >= lo && t <= hi)) throw invalid_input("sol(t): t lies outside the integrated span");
     State<V> s;
-    if (t_.size() == 1) {
-      s.q = q_[0];
-      s.v = v_[0];
-      return s;
+    std::size_t k = 0;
+    if (find(t, k, s)) return s;
+    if (!step_) {
+      segment(k, t, s);
+    } else {
+      step_(t_[k], q_[k], v_[k], t, s.q, s.v);
     }
-    // The step containing t: the first step end at or past t in the direction of integration.
-    std::size_t k;
-    if (fwd)
-      k = static_cast<std::size_t>(std::lower_bound(t_.begin(), t_.end(), t) - t_.begin());
-    else
-      k = static_cast<std::size_t>(
-          std::lower_bound(t_.begin(), t_.end(), t, [](const real_type& a, const real_type& b) { return a > b; }) -
-          t_.begin());
-    if (k == 0) k = 1;
-    if (k >= t_.size()) k = t_.size() - 1;
-    if (t == t_[k]) {
-      s.q = q_[k];
-      s.v = v_[k];
-      return s;
-    }
-    segment(k - 1, t, s);
     return s;
   }
 
-  /// The state at t inside step k (between step ends k and k + 1).
+  /// The quintic Hermite interpolant at t (no force evaluation; order 6, see above).
+  State<V> hermite(const real_type& t) const {
+    State<V> s;
+    std::size_t k = 0;
+    if (!find(t, k, s)) segment(k, t, s);
+    return s;
+  }
+
+  /// The Hermite interpolant at t inside step k (between step ends k and k + 1).
   void segment(std::size_t k, const real_type& t, State<V>& s) const {
     const real_type h = t_[k + 1] - t_[k];
     hermite_quintic(q_[k], v_[k], a_[k], q_[k + 1], v_[k + 1], a_[k + 1], h, real_type((t - t_[k]) / h), s.q, s.v);
   }
 
  private:
+  // The step [t_k, t_k+1] containing t in k; true (and the stored state in s) when t is a step end.
+  bool find(const real_type& t, std::size_t& k, State<V>& s) const {
+    if (t_.empty()) throw invalid_input("no dense output was kept (SolveOptions::dense)");
+    const bool fwd = t_.back() >= t_.front();
+    const real_type lo = fwd ? t_.front() : t_.back(), hi = fwd ? t_.back() : t_.front();
+    if (!(t >= lo && t <= hi)) throw invalid_input("sol(t): t lies outside the integrated span");
+    if (t_.size() == 1) {
+      s.q = q_[0];
+      s.v = v_[0];
+      return true;
+    }
+    // The first step end at or past t in the direction of integration.
+    std::size_t j;
+    if (fwd)
+      j = static_cast<std::size_t>(std::lower_bound(t_.begin(), t_.end(), t) - t_.begin());
+    else
+      j = static_cast<std::size_t>(
+          std::lower_bound(t_.begin(), t_.end(), t, [](const real_type& a, const real_type& b) { return a > b; }) -
+          t_.begin());
+    if (j == 0) j = 1;
+    if (j >= t_.size()) j = t_.size() - 1;
+    if (t == t_[j] || t == t_[j - 1]) {
+      const std::size_t e = t == t_[j] ? j : j - 1;
+      s.q = q_[e];
+      s.v = v_[e];
+      return true;
+    }
+    k = j - 1;
+    return false;
+  }
+
   std::vector<real_type> t_;
   std::vector<V> q_, v_, a_;
+  PartialStep step_;
 };
 
 }  // namespace nystrom

@@ -32,6 +32,8 @@
 #include <cstddef>
 #include <functional>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -61,11 +63,13 @@ struct SolveOptions {
   /// (atol 0: atol = rtol).
   double rtol = 0;
   double atol = 0;
-  /// Output times, monotone in the direction of integration, within the span (from the dense output).
-  /// Empty: the state at every step end (and at t0).
+  /// Output times, monotone in the direction of integration, within the span (by partial steps of the
+  /// method, as sol(t); their forces are counted in output_force_evals). Empty: the state at every step
+  /// end (and at t0).
   std::vector<double> t_eval{};
-  /// Keep every step end for sol(t) (one force evaluation per step end where the method does not
-  /// provide it; counted in output_force_evals).
+  /// Keep every step end, and a copy of the method and force, for sol(t) (solve/dense.hpp): one force
+  /// evaluation per step end for the Hermite interpolant, counted in output_force_evals. Output times
+  /// and events do not need it.
   bool dense = true;
   /// The largest number of steps (accepted and rejected).
   long max_steps = 10000000;
@@ -217,17 +221,23 @@ std::size_t unflatten(const std::vector<T>& in, std::size_t pos, VE& x) {
 }
 
 /// Receives every accepted step end (user time and state), keeps the dense output, the saved states
-/// and the events, and says when a terminal event stops the run.
+/// and the events, and says when a terminal event stops the run. Output times and events inside a
+/// step come from the partial step of the method (DenseOutput::PartialStep); an event is bracketed
+/// by the signs of g at the step ends, started at the zero of g on the Hermite interpolant and then
+/// located on the partial step.
 template <class V, class P>
 class Recorder {
  public:
   using R = real_t<typename V::value_type>;
+  using PartialStep = typename DenseOutput<V>::PartialStep;
 
-  Recorder(P& prob, const SolveOptions& opt, const std::vector<Event<V>>& events, Solution<V>& sol, int dir)
-      : prob_(prob), opt_(opt), events_(events), sol_(sol), dir_(dir) {
-    need_a_ = opt.dense || !events.empty() || !opt.t_eval.empty();
+  Recorder(P& prob, const SolveOptions& opt, const std::vector<Event<V>>& events, Solution<V>& sol, int dir,
+           PartialStep partial)
+      : prob_(prob), opt_(opt), events_(events), sol_(sol), dir_(dir), partial_(std::move(partial)) {
+    need_a_ = opt.dense || !events.empty();
     for (const auto& e : events_)
       if (!e.g) throw invalid_input("event '" + e.name + "' has no function");
+    if (opt.dense) sol_.dense.set_partial_step(partial_);
   }
 
   void start(const R& t, const V& q, const V& v) {
@@ -266,7 +276,7 @@ class Recorder {
     bool terminal = false;
     R t_end = t;
     for (const auto& [te, i] : hits) {
-      State<V> s = interpolate(t, q, v, a, te);
+      State<V> s = interpolate(t, q, v, te);
       sol_.events.push_back({events_[i].name, i, te, s.q, s.v});
       if (events_[i].terminal) {
         terminal = true;
@@ -285,12 +295,8 @@ class Recorder {
     } else {
       while (next_ < opt_.t_eval.size() && dir_ * R(opt_.t_eval[next_]) <= dir_ * t_end) {
         const R te = R(opt_.t_eval[next_++]);
-        if (te == t) {
-          save(t, q, v);
-        } else {
-          State<V> s = interpolate(t, q, v, a, te);
-          save(te, s.q, s.v);
-        }
+        State<V> s = interpolate(t, q, v, te);
+        save(te, s.q, s.v);
       }
     }
     if (opt_.dense) {
@@ -327,26 +333,52 @@ class Recorder {
     sol_.q.push_back(q);
     sol_.v.push_back(v);
   }
-  State<V> interpolate(const R& t, const V& q, const V& v, const V& a, const R& te) const {
+  // The state at te in the step (tp, t] that ended at (t, q, v): the step end itself, or a partial step.
+  State<V> interpolate(const R& t, const V& q, const V& v, const R& te) {
     State<V> s;
-    const R h = t - tp_;
-    hermite_quintic(qp_, vp_, ap_, q, v, a, h, R((te - tp_) / h), s.q, s.v);
+    if (te == t) {
+      s.q = q;
+      s.v = v;
+    } else if (te == tp_) {
+      s.q = qp_;
+      s.v = vp_;
+    } else {
+      sol_.output_force_evals += partial_(tp_, qp_, vp_, te, s.q, s.v);
+    }
     return s;
   }
-  // The zero of event i in (tp, t) on the dense output: the Illinois variant of regula falsi, to a few
-  // units of rounding of t (or 200 iterations).
-  R locate(std::size_t i, const R& t, const V& q, const V& v, const V& a, R ga, R gb) {
-    using std::abs;
-    R lo = tp_, hi = t;
+  // The zero of event i in (tp, t): a first estimate on the Hermite interpolant (no force evaluations),
+  // then on the partial step.
+  R locate(std::size_t i, const R& t, const V& q, const V& v, const V& a, const R& ga, const R& gb) {
     if (gb == R(0)) return t;
+    const R h = t - tp_;
+    const R guess = illinois(
+        [&](const R& m) {
+          State<V> s;
+          hermite_quintic(qp_, vp_, ap_, q, v, a, h, R((m - tp_) / h), s.q, s.v);
+          return events_[i].g(m, s.q, s.v);
+        },
+        tp_, t, ga, gb, tp_);
+    return illinois(
+        [&](const R& m) {
+          const State<V> s = interpolate(t, q, v, m);
+          return events_[i].g(m, s.q, s.v);
+        },
+        tp_, t, ga, gb, guess);
+  }
+  // The zero of g in the bracket (lo, hi) with g(lo) = ga and g(hi) = gb of opposite signs, by the
+  // Illinois variant of regula falsi from a first point `first` (used when strictly inside), to a few
+  // units of rounding of t (or 100 evaluations of g).
+  template <class G>
+  static R illinois(G&& gfun, R lo, R hi, R ga, R gb, const R& first) {
+    using std::abs;
     int side = 0;
     const R eps = epsilon_of<R>();
-    for (int it = 0; it < 200; ++it) {
+    for (int it = 0; it < 100; ++it) {
       if (abs(hi - lo) <= R(4) * eps * std::max(abs(lo), abs(hi))) break;
-      R m = (lo * gb - hi * ga) / (gb - ga);
+      R m = (it == 0 && (first - lo) * (hi - first) > R(0)) ? first : R((lo * gb - hi * ga) / (gb - ga));
       if (!((m - lo) * (hi - m) > R(0))) m = (lo + hi) / R(2);  // strictly inside the bracket
-      const State<V> s = interpolate(t, q, v, a, m);
-      const R gm = events_[i].g(m, s.q, s.v);
+      const R gm = gfun(m);
       if (gm == R(0)) return m;
       if ((gm < R(0)) == (ga < R(0))) {
         lo = m;
@@ -368,6 +400,7 @@ class Recorder {
   const std::vector<Event<V>>& events_;
   Solution<V>& sol_;
   int dir_;
+  PartialStep partial_;
   bool need_a_ = true;
   std::size_t next_ = 0;
   R tp_{};
@@ -375,13 +408,100 @@ class Recorder {
   std::vector<R> gp_;
 };
 
+/// Conversions between the user's state (time t, q, v) and the engine's (time-reversed for backward
+/// integration, complexified for complex-coefficient methods, with t as one more coordinate when the
+/// force depends on time).
+template <class V, class VE, bool TD>
+struct Conversion {
+  using R = real_t<typename V::value_type>;
+  using S = typename VE::value_type;
+  int dir = 1;
+  std::size_t n = 0;
+
+  State<VE> to_engine(const R& t, const V& q, const V& v) const {
+    State<VE> s{make_vector<VE>(n + (TD ? 1 : 0)), make_vector<VE>(n + (TD ? 1 : 0))};
+    for (std::size_t i = 0; i < n; ++i) {
+      s.q[i] = S(q[i]);
+      s.v[i] = S(sgn_mul(dir, v[i]));
+    }
+    if constexpr (TD) {
+      s.q[n] = S(sgn_mul(dir, t));
+      s.v[n] = S(1);
+    } else {
+      (void)t;
+    }
+    return s;
+  }
+  void from_engine(const State<VE>& s, V& q, V& v) const {
+    q = make_vector<V>(n);
+    v = make_vector<V>(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      if constexpr (is_complex_v<S>) {
+        q[i] = s.q[i].real();
+        v[i] = sgn_mul(dir, R(s.v[i].real()));
+      } else {
+        q[i] = s.q[i];
+        v[i] = sgn_mul(dir, s.v[i]);
+      }
+    }
+  }
+};
+
+template <class E>
+struct is_gbs : std::false_type {};
+template <class VE, class F>
+struct is_gbs<GbsIntegrator<VE, F>> : std::true_type {};
+
+/// The partial step of a solution's dense output (DenseOutput::PartialStep): one step of the method
+/// from a step end, on a copy of the engine that the solution keeps (with its copy of the force) after
+/// solve() returns. A fixed-step Integrator takes one step with its compensation restarted; GBS runs a
+/// fresh copy of the extrapolation integrator over the interval. A mutex makes concurrent calls safe.
+template <class V, class VE, bool TD, class Engine>
+class PartialStepper {
+ public:
+  using R = real_t<typename V::value_type>;
+
+  PartialStepper(Conversion<V, VE, TD> conv, Engine engine) : p_(std::make_shared<Shared>(conv, std::move(engine))) {}
+
+  long operator()(const R& t0, const V& q0, const V& v0, const R& t, V& q, V& v) const {
+    Shared& p = *p_;
+    std::lock_guard<std::mutex> lock(p.m);
+    State<VE> s = p.conv.to_engine(t0, q0, v0);
+    const R h = sgn_mul(p.conv.dir, R(t - t0));
+    long evals = 0;
+    if (h > R(0)) {
+      if constexpr (is_gbs<Engine>::value) {
+        Engine g = p.engine;
+        g.integrate_to(s, h);
+        evals = g.force_evals() - p.engine.force_evals();
+      } else {
+        const long e0 = p.engine.force_evals();
+        p.engine.compensator().valid = false;  // no carry from an earlier call
+        p.engine.integrate(s, h, 1);
+        evals = p.engine.force_evals() - e0;
+      }
+    }
+    p.conv.from_engine(s, q, v);
+    return evals;
+  }
+
+ private:
+  struct Shared {
+    Shared(Conversion<V, VE, TD> c, Engine e) : conv(c), engine(std::move(e)) {}
+    std::mutex m;
+    Conversion<V, VE, TD> conv;
+    Engine engine;
+  };
+  std::shared_ptr<Shared> p_;
+};
+
 /// Common state of a run: problem, options, direction, conversions between the user's state and the
 /// engine's.
 template <class V, class F, class VE>
 struct Run {
   using R = real_t<typename V::value_type>;
-  using S = typename VE::value_type;
   static constexpr bool td = SecondOrderProblem<V, F>::time_dependent;
+  using Force = EngineForce<V, VE, F, td>;
 
   SecondOrderProblem<V, F>& prob;
   const SolveOptions& opt;
@@ -399,36 +519,99 @@ struct Run {
     sol.checkpoint = c;
   }
 
-  State<VE> to_engine(const R& t, const V& q, const V& v) const {
-    State<VE> s{make_vector<VE>(n + (td ? 1 : 0)), make_vector<VE>(n + (td ? 1 : 0))};
-    for (std::size_t i = 0; i < n; ++i) {
-      s.q[i] = S(q[i]);
-      s.v[i] = S(sgn_mul(dir, v[i]));
-    }
-    if constexpr (td) {
-      s.q[n] = S(sgn_mul(dir, t));
-      s.v[n] = S(1);
-    }
-    return s;
+  Conversion<V, VE, td> conversion() const { return {dir, n}; }
+  State<VE> to_engine(const R& t, const V& q, const V& v) const { return conversion().to_engine(t, q, v); }
+  void from_engine(const State<VE>& s, V& q, V& v) const { conversion().from_engine(s, q, v); }
+  Force force() const { return {prob.force, dir, n, {}, {}}; }
+  /// The dense output's partial step with `engine` (a copy the solution keeps).
+  template <class Engine>
+  typename DenseOutput<V>::PartialStep partial_step(Engine engine) const {
+    return PartialStepper<V, VE, td, Engine>(conversion(), std::move(engine));
   }
-  void from_engine(const State<VE>& s, V& q, V& v) const {
-    q = make_vector<V>(n);
-    v = make_vector<V>(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      if constexpr (is_complex_v<S>) {
-        q[i] = s.q[i].real();
-        v[i] = sgn_mul(dir, R(s.v[i].real()));
-      } else {
-        q[i] = s.q[i];
-        v[i] = sgn_mul(dir, s.v[i]);
-      }
-    }
+  /// The fixed-step method that the adaptive engines propagate (the high-order weights of an RKN pair,
+  /// the whole multi-product expansion of an adaptive one), for the partial steps.
+  typename DenseOutput<V>::PartialStep propagated_method(const MethodDef& def) const {
+    using T = real_t<typename VE::value_type>;
+    const MethodData data = method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
+    return partial_step(Integrator<VE, Force>(data, force(), opt.engine));
   }
-  EngineForce<V, VE, F, td> force() const { return {prob.force, dir, n, {}, {}}; }
   void check_finite(const V& q, const V& v, const R& ta, const R& tb) const {
     if (!all_finite(q) || !all_finite(v))
       throw error("the state became NaN or infinite in the step from t = " + adaptive_detail::sci(as_double(ta)) +
                   " to t = " + adaptive_detail::sci(as_double(tb)) + " (the force returned NaN or infinity)");
+  }
+  /// Restores the state of a checkpoint into s.
+  void restore(const Checkpoint<R>& c, State<VE>& s) const {
+    std::size_t pos = unflatten(c.state, 0, s.q);
+    pos = unflatten(c.state, pos, s.v);
+    if (pos != c.state.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
+  }
+  /// And its compensation carries into the engine's compensator.
+  void restore(const Checkpoint<R>& c, State<VE>& s, Compensator<VE>& comp) const {
+    restore(c, s);
+    if (!c.carry.empty()) {
+      VE cq = s.q, cv = s.v;
+      std::size_t p2 = unflatten(c.carry, 0, cq);
+      p2 = unflatten(c.carry, p2, cv);
+      if (p2 != c.carry.size()) throw invalid_input("checkpoint: the carries have the wrong size");
+      comp.restore(cq, cv, s);
+    }
+  }
+};
+
+/// The observer of the adaptive and GBS engines: records every accepted step end and stops the engine
+/// for a terminal event or where the checkpoint is due.
+template <class V, class F, class VE>
+struct StepEnds {
+  using R = real_t<typename V::value_type>;
+  const Run<V, F, VE>& run;
+  Recorder<V, SecondOrderProblem<V, F>>& rec;
+  V q{}, v{};
+  R tprev{};
+  bool taken = false, terminal = false, want_checkpoint = false;
+
+  StepEnds(const Run<V, F, VE>& r, Recorder<V, SecondOrderProblem<V, F>>& rc, const R& t_start, const State<VE>& s)
+      : run(r), rec(rc), tprev(t_start), taken(!std::isfinite(r.opt.checkpoint_at)) {
+    run.from_engine(s, q, v);
+    rec.start(t_start, q, v);
+  }
+  /// A step ended at user time t with engine state st: true to stop the engine there.
+  bool operator()(const R& t, const State<VE>& st) {
+    run.from_engine(st, q, v);
+    run.check_finite(q, v, tprev, t);
+    tprev = t;
+    if (rec.step(t, q, v)) {
+      terminal = true;
+      return true;
+    }
+    if (!taken && run.dir * as_double(t) >= run.dir * run.opt.checkpoint_at) {
+      taken = true;
+      want_checkpoint = true;
+      return true;
+    }
+    return false;
+  }
+  /// Runs advance() (the engine from where it stands to the end, observed by *this) until the end or a
+  /// terminal event; where it stopped for the checkpoint, fill(c) completes the checkpoint c and the
+  /// engine goes on from its resume point (the same steps as without the stop).
+  template <class Advance, class Fill>
+  void drive(Solution<V>& sol, Advance&& advance, Fill&& fill) {
+    for (;;) {
+      want_checkpoint = false;
+      advance();
+      if (terminal || !want_checkpoint) break;
+      Checkpoint<R> c;
+      fill(c);
+      c.output_force_evals = sol.output_force_evals;
+      run.take(c, sol);
+    }
+  }
+  void finish(Solution<V>& sol) const {
+    if (sol.status == SolveStatus::success) {
+      sol.t_final = run.prob.t1;
+      sol.q_final = q;
+      sol.v_final = v;
+    }
   }
 };
 
@@ -459,21 +642,12 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
   State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
   long k0 = 0;
   long evals0 = 0;
-  Recorder<V, SecondOrderProblem<V, F>> rec(prob, opt, events, sol, dir);
+  Recorder<V, SecondOrderProblem<V, F>> rec(prob, opt, events, sol, dir, run.partial_step(integ));
   if (resume) {
     if (resume->engine != "fixed") throw invalid_input("checkpoint of another engine (" + resume->engine + ")");
     k0 = resume->step_index;
     if (k0 < 0 || k0 > n) throw invalid_input("checkpoint step index outside the run");
-    std::size_t pos = unflatten(resume->state, 0, s.q);
-    pos = unflatten(resume->state, pos, s.v);
-    if (pos != resume->state.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
-    if (!resume->carry.empty()) {
-      VE cq = s.q, cv = s.v;
-      std::size_t p2 = unflatten(resume->carry, 0, cq);
-      p2 = unflatten(resume->carry, p2, cv);
-      if (p2 != resume->carry.size()) throw invalid_input("checkpoint: the carries have the wrong size");
-      integ.compensator().restore(cq, cv, s);
-    }
+    run.restore(*resume, s, integ.compensator());
     evals0 = resume->force_evals;
     sol.output_force_evals = resume->output_force_evals;
   }
@@ -521,7 +695,7 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
 
 /// Adaptive RKN or MPE (Engine: AdaptiveRknIntegrator or AdaptiveMpeIntegrator on VE).
 template <class VE, class V, class F, class Engine>
-void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, Solution<V>& sol,
+void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, const MethodDef& def, Solution<V>& sol,
                   const std::vector<Event<V>>& events, const Checkpoint<real_t<typename V::value_type>>* resume) {
   using R = real_t<typename V::value_type>;
   auto& prob = run.prob;
@@ -533,18 +707,10 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, Solution
   if (resume) {
     if (resume->engine != name)
       throw invalid_input(std::string("checkpoint of another engine (") + resume->engine + ")");
-    std::size_t pos = unflatten(resume->state, 0, s.q);
-    pos = unflatten(resume->state, pos, s.v);
-    if (pos != resume->state.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
-    if constexpr (requires { engine.compensator(); }) {
-      if (!resume->carry.empty()) {
-        VE cq = s.q, cv = s.v;
-        std::size_t p2 = unflatten(resume->carry, 0, cq);
-        p2 = unflatten(resume->carry, p2, cv);
-        if (p2 != resume->carry.size()) throw invalid_input("checkpoint: the carries have the wrong size");
-        engine.compensator().restore(cq, cv, s);
-      }
-    }
+    if constexpr (requires { engine.compensator(); })
+      run.restore(*resume, s, engine.compensator());
+    else
+      run.restore(*resume, s);
     tau = sgn_mul(dir, resume->t);
     engine.set_resume_point(
         {tau, resume->h_want, resume->hmax, resume->last_rejected, resume->q_prev, resume->h_prev, true});
@@ -553,66 +719,40 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, Solution
     rej0 = resume->rejected;
     sol.output_force_evals = resume->output_force_evals;
   }
-  Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir);
-  V q, v;
-  run.from_engine(s, q, v);
-  rec.start(sgn_mul(dir, tau), q, v);
-  bool taken = !std::isfinite(run.opt.checkpoint_at);
-  bool terminal = false, want_checkpoint = false;
-  R tprev = sgn_mul(dir, tau);
+  Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir, run.propagated_method(def));
+  StepEnds<V, F, VE> ends(run, rec, sgn_mul(dir, tau), s);
   auto obs = [&](const R& tt, const State<VE>& st) -> bool {
     if (tt == tau) return false;  // the start
-    const R t = tt == tau1 ? prob.t1 : sgn_mul(dir, tt);
-    run.from_engine(st, q, v);
-    run.check_finite(q, v, tprev, t);
-    tprev = t;
-    if (rec.step(t, q, v)) {
-      terminal = true;
-      return true;
-    }
-    if (!taken && dir * as_double(t) >= dir * run.opt.checkpoint_at) {
-      taken = true;
-      want_checkpoint = true;
-      return true;
-    }
-    return false;
+    return ends(tt == tau1 ? prob.t1 : sgn_mul(dir, tt), st);
   };
-  for (;;) {
-    want_checkpoint = false;
-    engine.integrate_to(s, tau, tau1, obs);
-    if (terminal || !want_checkpoint) break;
-    const auto& rp = engine.resume_point();
-    Checkpoint<R> c;
-    c.engine = name;
-    c.t = sgn_mul(dir, rp.t);
-    flatten(s.q, c.state);
-    flatten(s.v, c.state);
-    if constexpr (requires { engine.compensator(); }) {
-      if (use_compensation<typename VE::value_type>(run.opt.engine.compensated)) {
-        flatten(engine.compensator().cq, c.carry);
-        flatten(engine.compensator().cv, c.carry);
-      }
-    }
-    c.h_want = rp.h_want;
-    c.hmax = rp.hmax;
-    c.last_rejected = rp.last_rejected;
-    c.q_prev = rp.q_prev;
-    c.h_prev = rp.h_prev;
-    c.force_evals = evals0 + engine.total().force_evals;
-    c.output_force_evals = sol.output_force_evals;
-    c.accepted = acc0 + engine.total().accepted;
-    c.rejected = rej0 + engine.total().rejected;
-    run.take(c, sol);
-    tau = rp.t;  // go on from the resume point: the same steps as without the stop
-  }
+  ends.drive(
+      sol, [&] { engine.integrate_to(s, tau, tau1, obs); },
+      [&](Checkpoint<R>& c) {
+        const auto& rp = engine.resume_point();
+        c.engine = name;
+        c.t = sgn_mul(dir, rp.t);
+        flatten(s.q, c.state);
+        flatten(s.v, c.state);
+        if constexpr (requires { engine.compensator(); }) {
+          if (use_compensation<typename VE::value_type>(run.opt.engine.compensated)) {
+            flatten(engine.compensator().cq, c.carry);
+            flatten(engine.compensator().cv, c.carry);
+          }
+        }
+        c.h_want = rp.h_want;
+        c.hmax = rp.hmax;
+        c.last_rejected = rp.last_rejected;
+        c.q_prev = rp.q_prev;
+        c.h_prev = rp.h_prev;
+        c.force_evals = evals0 + engine.total().force_evals;
+        c.accepted = acc0 + engine.total().accepted;
+        c.rejected = rej0 + engine.total().rejected;
+        tau = rp.t;  // go on from the resume point
+      });
   sol.force_evals = evals0 + engine.total().force_evals;
   sol.accepted = acc0 + engine.total().accepted;
   sol.rejected = rej0 + engine.total().rejected;
-  if (sol.status == SolveStatus::success) {
-    sol.t_final = prob.t1;
-    sol.q_final = q;
-    sol.v_final = v;
-  }
+  ends.finish(sol);
 }
 
 template <class VE, class V, class F>
@@ -625,74 +765,53 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
   go.rtol = run.opt.rtol;
   go.atol = run.opt.atol > 0 ? run.opt.atol : run.opt.rtol;
   go.max_steps = run.opt.max_steps;
-  GbsIntegrator<VE, decltype(run.force())> g(run.force(), go);
+  GbsIntegrator<VE, typename Run<V, F, VE>::Force> g(run.force(), go);
   const R tau0 = sgn_mul(dir, prob.t0);
   const R span = sgn_mul(dir, R(prob.t1 - prob.t0));
   State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
   R t_start = prob.t0;
-  long evals0 = 0;
+  // The partial steps run a fresh copy of the integrator (its controller in the initial state) at a
+  // tolerance 1000 times smaller (bounded by rounding): GBS's accepted steps are usually far more
+  // accurate than its tolerance (the estimate is that of the column before the accepted one), and a
+  // partial step must not be less accurate than the steps it lies between.
+  GbsOptions gp = go;
+  gp.rtol = std::max(go.rtol * 1e-3, 100 * as_double(epsilon_of<R>()));
+  gp.atol = std::max(go.atol * 1e-3, 100 * as_double(epsilon_of<R>()));
+  Recorder<V, SecondOrderProblem<V, F>> rec(
+      prob, run.opt, events, sol, dir,
+      run.partial_step(GbsIntegrator<VE, typename Run<V, F, VE>::Force>(run.force(), gp)));
   if (resume) {
     if (resume->engine != "gbs") throw invalid_input("checkpoint of another engine (" + resume->engine + ")");
-    std::size_t pos = unflatten(resume->state, 0, s.q);
-    pos = unflatten(resume->state, pos, s.v);
-    if (pos != resume->state.size()) throw invalid_input("checkpoint: the state has the wrong size for this problem");
+    run.restore(*resume, s);
     g.set_resume_point({resume->span, span, resume->h_want, resume->columns, resume->last_rejected, true});
     g.set_counters(resume->force_evals, resume->accepted, resume->rejected);
     t_start = resume->t;
     sol.output_force_evals = resume->output_force_evals;
   }
-  (void)evals0;
-  Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir);
-  V q, v;
-  run.from_engine(s, q, v);
-  rec.start(t_start, q, v);
-  bool taken = !std::isfinite(run.opt.checkpoint_at);
-  bool terminal = false, want_checkpoint = false;
-  R tprev = t_start;
+  StepEnds<V, F, VE> ends(run, rec, t_start, s);
   auto obs = [&](const R& trel, const State<VE>& st) -> bool {
-    const R t = trel == span ? prob.t1 : sgn_mul(dir, R(tau0 + trel));
-    run.from_engine(st, q, v);
-    run.check_finite(q, v, tprev, t);
-    tprev = t;
-    if (rec.step(t, q, v)) {
-      terminal = true;
-      return true;
-    }
-    if (!taken && dir * as_double(t) >= dir * run.opt.checkpoint_at) {
-      taken = true;
-      want_checkpoint = true;
-      return true;
-    }
-    return false;
+    return ends(trel == span ? prob.t1 : sgn_mul(dir, R(tau0 + trel)), st);
   };
-  for (;;) {
-    want_checkpoint = false;
-    g.integrate_to(s, span, obs);
-    if (terminal || !want_checkpoint) break;
-    const auto& rp = g.resume_point();
-    Checkpoint<R> c;
-    c.engine = "gbs";
-    c.t = sgn_mul(dir, R(tau0 + rp.t));
-    c.span = rp.t;
-    flatten(s.q, c.state);
-    flatten(s.v, c.state);
-    c.h_want = rp.H;
-    c.columns = rp.k;
-    c.last_rejected = rp.last_rejected;
-    c.force_evals = g.force_evals();
-    c.output_force_evals = sol.output_force_evals;
-    c.accepted = g.steps();
-    c.rejected = g.rejected();
-    run.take(c, sol);
-  }
+  ends.drive(
+      sol, [&] { g.integrate_to(s, span, obs); },
+      [&](Checkpoint<R>& c) {
+        const auto& rp = g.resume_point();
+        c.engine = "gbs";
+        c.t = sgn_mul(dir, R(tau0 + rp.t));
+        c.span = rp.t;
+        flatten(s.q, c.state);
+        flatten(s.v, c.state);
+        c.h_want = rp.H;
+        c.columns = rp.k;
+        c.last_rejected = rp.last_rejected;
+        c.force_evals = g.force_evals();
+        c.accepted = g.steps();
+        c.rejected = g.rejected();
+      });
   sol.force_evals = g.force_evals();
   sol.accepted = g.steps();
   sol.rejected = g.rejected();
-  if (sol.status == SolveStatus::success) {
-    sol.t_final = prob.t1;
-    sol.q_final = q;
-    sol.v_final = v;
-  }
+  ends.finish(sol);
 }
 
 template <class V, class F>
@@ -725,7 +844,7 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
   if (resume && resume->method != def.info.name)
     throw invalid_input("the checkpoint was taken with method '" + resume->method + "', not '" + def.info.name + "'");
   if (prob.t1 == prob.t0) {
-    Recorder<V, P> rec(prob, opt, events, sol, dir);
+    Recorder<V, P> rec(prob, opt, events, sol, dir, {});
     rec.start(prob.t0, prob.q0, prob.v0);
     sol.t_final = prob.t0;
     sol.q_final = prob.q0;
@@ -749,10 +868,10 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
       ao.max_steps = opt.max_steps;
       if (std::holds_alternative<MpeDef>(def.build())) {
         auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);
-        run_adaptive<VE>(run, engine, "adaptive-mpe", sol, events, resume);
+        run_adaptive<VE>(run, engine, "adaptive-mpe", def, sol, events, resume);
       } else {
         auto engine = make_adaptive_integrator<VE>(def, run.force(), ao);
-        run_adaptive<VE>(run, engine, "adaptive-rkn", sol, events, resume);
+        run_adaptive<VE>(run, engine, "adaptive-rkn", def, sol, events, resume);
       }
     }
   } else if (def.info.complex) {
