@@ -12,9 +12,14 @@ jobs=${NYSTROM_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}
 build=build/fuzz
 san="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 
-CXX=clang++-14 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
-  -DCMAKE_CXX_FLAGS="$san -Werror" -DNYSTROM_BUILD_FUZZERS=ON -DNYSTROM_BUILD_TOOL=OFF -DNYSTROM_BUILD_TESTS=OFF \
-  -DNYSTROM_BUILD_BENCH=OFF -DNYSTROM_BUILD_EXAMPLES=OFF -DNYSTROM_PCH=OFF >/dev/null
+# Ninja and ccache when present (a folder configured before keeps its generator).
+extra=()
+if [ ! -f "$build/CMakeCache.txt" ] && command -v ninja >/dev/null; then extra+=(-G Ninja); fi
+if command -v ccache >/dev/null; then extra+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+CXX=clang++-14 cmake -S . -B "$build" "${extra[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS="$san -Werror" -DNYSTROM_BUILD_FUZZERS=ON \
+  -DNYSTROM_BUILD_TOOL=OFF -DNYSTROM_BUILD_TESTS=OFF -DNYSTROM_BUILD_BENCH=OFF -DNYSTROM_BUILD_EXAMPLES=OFF \
+  -DNYSTROM_PCH=OFF >/dev/null
 targets=()
 for h in $harnesses; do targets+=("fuzz_$h"); done
 cmake --build "$build" -j "$jobs" --target "${targets[@]}"

@@ -254,12 +254,62 @@ long checked_count(double value, double max, const std::string& what) {
   return n < 1 ? 1 : n;
 }
 
+namespace {
+
+// The value as quoted in a message: at most 40 characters.
+std::string shown(const std::string& v) { return "'" + (v.size() > 40 ? v.substr(0, 40) + "..." : v) + "'"; }
+
+// The syntax check of every numeric option: an empty string when `v` is a valid number of its kind.
+std::string strict_number_error(const std::string& v, bool integer, bool unsigned_) {
+  if (const auto err = number_syntax_error(v, integer); !err.empty())
+    return "must be " + std::string(integer ? "a whole number" : "a finite number") + ", got " + shown(v);
+  if (unsigned_ && v[0] == '-') return "must not be negative, got " + shown(v);
+  if (integer) {
+    long long x = 0;
+    const char* b = v.c_str() + (v[0] == '+' ? 1 : 0);
+    const auto [p, ec] = std::from_chars(b, v.c_str() + v.size(), x);
+    if (ec != std::errc() || p != v.c_str() + v.size()) return "is out of range, got " + shown(v);
+  } else {
+    errno = 0;
+    const double x = std::strtod(v.c_str(), nullptr);
+    if (!std::isfinite(x) || (errno == ERANGE && std::abs(x) > 1)) return "must be finite, got " + shown(v);
+  }
+  return "";
+}
+
+// A bound as written in a message: a whole number in full up to 1e15, otherwise %g.
+std::string bound_text(double x) {
+  return x == std::floor(x) && std::abs(x) < 1e15 ? fmt::format("{:.0f}", x) : fmt::format("{:g}", x);
+}
+
+// A range check: the syntax of a number, then lo <= x <= hi (lo_open: lo < x).
+CLI::Validator bounded(double lo, bool lo_open, double hi, std::string description) {
+  return CLI::Validator(
+      [lo, lo_open, hi](std::string& v) -> std::string {
+        if (auto err = strict_number_error(v, false, false); !err.empty()) return err;
+        const double x = std::strtod(v.c_str(), nullptr);
+        if ((lo_open ? x > lo : x >= lo) && x <= hi) return "";
+        if (lo == 0 && std::isinf(hi))
+          return (lo_open ? "must be positive, got " : "must not be negative, got ") + shown(v);
+        return "must be between " + bound_text(lo) + " and " + bound_text(hi) + ", got " + shown(v);
+      },
+      std::move(description), "range");
+}
+
+}  // namespace
+
+CLI::Validator positive_check() { return bounded(0, true, HUGE_VAL, "POSITIVE"); }
+CLI::Validator non_negative_check() { return bounded(0, false, HUGE_VAL, "NONNEGATIVE"); }
+CLI::Validator range_check(double lo, double hi) {
+  return bounded(lo, false, hi, "[" + bound_text(lo) + " - " + bound_text(hi) + "]");
+}
+
 CLI::Validator eccentricity_check() {
   return CLI::Validator(
       [](std::string& v) -> std::string {
-        char* end = nullptr;
-        const double e = std::strtod(v.c_str(), &end);
-        return e >= 0 && e < 1 ? "" : "the eccentricity must satisfy 0 <= e < 1, got '" + v + "'";
+        if (auto err = strict_number_error(v, false, false); !err.empty()) return err;
+        const double e = std::strtod(v.c_str(), nullptr);
+        return e >= 0 && e < 1 ? "" : "the eccentricity must satisfy 0 <= e < 1, got " + shown(v);
       },
       "0 <= e < 1", "eccentricity");
 }
@@ -267,9 +317,9 @@ CLI::Validator eccentricity_check() {
 CLI::Validator tolerance_check() {
   return CLI::Validator(
       [](std::string& v) -> std::string {
-        char* end = nullptr;
-        const double t = std::strtod(v.c_str(), &end);
-        return t >= 1e-300 && t < 1e300 ? "" : "the tolerance must be positive (at least 1e-300), got '" + v + "'";
+        if (auto err = strict_number_error(v, false, false); !err.empty()) return err;
+        const double t = std::strtod(v.c_str(), nullptr);
+        return t >= 1e-300 && t < 1e300 ? "" : "the tolerance must be positive (at least 1e-300), got " + shown(v);
       },
       "positive", "tolerance");
 }
@@ -293,9 +343,8 @@ void check_work_budget(double units, const std::string& what) {
   }
   if (!(units <= limit))  // also NaN
     throw UsageError(
-        fmt::format("{}: the estimated work is {:.3g} force evaluations (in units of one double-precision "
-                    "Kepler force; an N-body force of n bodies counts n(n-1)/2), above the limit {:.3g} "
-                    "(about {:.3g} hours at 3 ns per unit; NYSTROM_WORK_LIMIT raises it)",
+        fmt::format("{}: the estimated work is {:.3g} force evaluations (of a double Kepler force; an N-body force "
+                    "counts n(n-1)/2), above the limit {:.3g}, about {:.3g} hours (NYSTROM_WORK_LIMIT raises it)",
                     what, units, limit, units * 3e-9 / 3600));
 }
 
@@ -546,22 +595,7 @@ void add_strict_validators(CLI::App& app) {
       const bool integer = type != "FLOAT";
       const bool unsigned_ = type == "UINT";
       opt->check(CLI::Validator(
-          [integer, unsigned_](std::string& v) -> std::string {
-            if (const auto err = number_syntax_error(v, integer); !err.empty())
-              return "must be " + std::string(integer ? "a whole number" : "a finite number") + ", got '" + v + "'";
-            if (unsigned_ && v[0] == '-') return "must not be negative, got '" + v + "'";
-            if (integer) {
-              long long x = 0;
-              const char* b = v.c_str() + (v[0] == '+' ? 1 : 0);
-              const auto [p, ec] = std::from_chars(b, v.c_str() + v.size(), x);
-              if (ec != std::errc() || p != v.c_str() + v.size()) return "is out of range, got '" + v + "'";
-            } else {
-              errno = 0;
-              const double x = std::strtod(v.c_str(), nullptr);
-              if (!std::isfinite(x) || (errno == ERANGE && std::abs(x) > 1)) return "must be finite, got '" + v + "'";
-            }
-            return "";
-          },
+          [integer, unsigned_](std::string& v) -> std::string { return strict_number_error(v, integer, unsigned_); },
           "", "strict number"));
     } else if (type == "TEXT") {
       opt->check(CLI::Validator([](std::string& v) -> std::string { return v.empty() ? "must not be empty" : ""; }, "",

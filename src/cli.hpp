@@ -84,6 +84,13 @@ void check_work_budget(double units, const std::string& what);
 CLI::Validator eccentricity_check();
 CLI::Validator tolerance_check();
 
+/// CLI11 range checks with one short message each ("must be positive, got '-5'", "must be between 2 and
+/// 1000000, got '0'"), used instead of CLI::PositiveNumber, CLI::NonNegativeNumber and CLI::Range (whose
+/// messages print the bounds of a double with hundreds of digits). Each checks the number's syntax first.
+CLI::Validator positive_check();
+CLI::Validator non_negative_check();
+CLI::Validator range_check(double lo, double hi);
+
 /// Relative cost of one force evaluation in a scalar type (double 1; measured ratios of bench_precision).
 double precision_cost(const std::string& precision);
 

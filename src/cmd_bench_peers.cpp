@@ -89,7 +89,7 @@ nystrom::cli::Registrar reg(
       app.add_option("--out", o->out, "Output folder (created if missing)")->capture_default_str();
       app.add_option("--periods", o->periods, "Orbital periods per run (1..10000)")
           ->capture_default_str()
-          ->check(CLI::Range(1L, 10000L));
+          ->check(nystrom::cli::range_check(1, 10000));
       app.add_option("--ecc", o->eccs, "Comma-separated eccentricities")->capture_default_str();
       app.add_flag("--no-plot", o->no_plot, "Do not draw the PNG charts");
       return [o]() {

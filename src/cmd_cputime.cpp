@@ -26,22 +26,22 @@ nystrom::cli::Registrar reg(
       app.add_option("--problem", s.problem, "Problem: nbody or twobody")->capture_default_str();
       app.add_option("--n", s.n, "Particles of the Plummer sphere")
           ->capture_default_str()
-          ->check(CLI::Range(2L, 1000000L));
+          ->check(nystrom::cli::range_check(2, 1000000));
       app.add_option("--seed", s.seed, "Seed of the Plummer sphere")->capture_default_str();
       app.add_option("--ic", s.ic_file, "Particle file instead of a Plummer sphere");
-      app.add_option("--eps", o->eps, "Softening length (default 1/N)")->check(CLI::NonNegativeNumber);
+      app.add_option("--eps", o->eps, "Softening length (default 1/N)")->check(nystrom::cli::non_negative_check());
       app.add_option("--threads", s.threads, "Force threads (0: OpenMP default)")
           ->capture_default_str()
-          ->check(CLI::Range(0, 1024));
+          ->check(nystrom::cli::range_check(0, 1024));
       app.add_option("--methods", o->methods, "Comma-separated methods (the leapfrog is always measured)")
           ->capture_default_str();
-      app.add_option("--h", o->cfg.h, "Step size")->capture_default_str()->check(CLI::PositiveNumber);
+      app.add_option("--h", o->cfg.h, "Step size")->capture_default_str()->check(nystrom::cli::positive_check());
       app.add_option("--steps", o->cfg.steps, "Timed steps per measurement")
           ->capture_default_str()
-          ->check(CLI::Range(1, 1000000));
+          ->check(nystrom::cli::range_check(1, 1000000));
       app.add_option("--repeats", o->cfg.repeats, "Measurements per method (the minimum is kept)")
           ->capture_default_str()
-          ->check(CLI::Range(1, 1000));
+          ->check(nystrom::cli::range_check(1, 1000));
       app.add_option("--csv", o->csv, "Write the table as CSV");
       return [o]() {
         using namespace nystrom::cli;

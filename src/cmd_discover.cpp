@@ -325,18 +325,18 @@ nystrom::cli::Registrar reg(
       app.add_option("--scheme", o->scheme, "A (RKNA, eq 3.6), B (RKNB, eq 3.8) or both")->capture_default_str();
       app.add_option("--starts", o->starts, "Random starts per scheme")
           ->capture_default_str()
-          ->check(CLI::Range(1L, 1000000L));
+          ->check(nystrom::cli::range_check(1, 1000000));
       app.add_option("--seed", o->seed, "Seed of the random starts")->capture_default_str();
       app.add_option("--threads", o->threads, "Threads (0: all cores, at most 8)")
           ->capture_default_str()
-          ->check(CLI::Range(0, 256));
+          ->check(nystrom::cli::range_check(0, 256));
       app.add_option("--solver", o->solver, "newton (damped) or lm (Levenberg-Marquardt)")->capture_default_str();
       app.add_option("--box", o->box, "Starts uniform in [-box, box] for real and imaginary parts")
           ->capture_default_str()
-          ->check(CLI::Range(1e-6, 1e6));
+          ->check(nystrom::cli::range_check(1e-6, 1e6));
       app.add_option("--polish-bits", o->polish_bits, "MPFR precision of the final Newton polish")
           ->capture_default_str()
-          ->check(CLI::Range(64u, 4096u));
+          ->check(nystrom::cli::range_check(64, 4096));
       app.add_option("--digits", o->digits, "Digits printed")->capture_default_str();
       app.add_option("--show", o->show,
                      "Methods listed: classified (REAL, IMAGINARY, positive), all, real, imaginary, positive")
@@ -350,13 +350,13 @@ nystrom::cli::Registrar reg(
       app.add_option("--from", o->from, "Start of --six-stage (an RKNA method)")->capture_default_str();
       app.add_option("--tries", o->tries, "--six-stage: the start plus tries-1 random moves along the constraints")
           ->capture_default_str()
-          ->check(CLI::Range(1, 100000));
+          ->check(nystrom::cli::range_check(1, 100000));
       app.add_option("--perturbation", o->perturbation, "--six-stage: size of the random moves")
           ->capture_default_str()
-          ->check(CLI::Range(0.0, 1e3));
+          ->check(nystrom::cli::range_check(0.0, 1e3));
       app.add_option("--six-bits", o->six_bits, "--six-stage: MPFR precision of the final polish (0: none)")
           ->capture_default_str()
-          ->check(CLI::Range(0u, 4096u));
+          ->check(nystrom::cli::range_check(0, 4096));
       app.footer(
           "Rediscovering Gurkan's Tables 4.1 and 4.2: `nystrom discover --seed 1` (2000 starts per scheme, the "
           "default)\n"

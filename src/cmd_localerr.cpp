@@ -28,24 +28,24 @@ nystrom::cli::Registrar reg(
           ->capture_default_str();
       app.add_option("--n", s.n, "Particles of the Plummer sphere")
           ->capture_default_str()
-          ->check(CLI::Range(2L, 1000000L));
+          ->check(nystrom::cli::range_check(2, 1000000));
       app.add_option("--seed", s.seed, "Seed of the Plummer sphere")->capture_default_str();
       app.add_option("--ic", s.ic_file, "Particle file (m,x,y,z,vx,vy,vz per line) instead of a Plummer sphere");
       app.add_option("--ecc", s.ecc, "Two-body eccentricity")
           ->capture_default_str()
           ->check(nystrom::cli::eccentricity_check());
       app.add_option("--eps", o->eps, "Softening length (default 1/N for nbody, 0 for twobody)")
-          ->check(CLI::NonNegativeNumber);
+          ->check(nystrom::cli::non_negative_check());
       app.add_option("--threads", s.threads, "Force threads (0: OpenMP default)")
           ->capture_default_str()
-          ->check(CLI::Range(0, 1024));
+          ->check(nystrom::cli::range_check(0, 1024));
       app.add_option("--methods", o->methods, "Comma-separated methods")->capture_default_str();
       app.add_option("--h", o->hs,
                      "FROM:TO:COUNT step sizes, log-spaced (orbital periods for twobody, time units for nbody)")
           ->capture_default_str();
       app.add_option("--duration", o->cfg.duration,
                      "Length of the run (default: 50 periods for twobody, 1 time unit for nbody)")
-          ->check(CLI::PositiveNumber);
+          ->check(nystrom::cli::positive_check());
       app.add_option("--tol", o->cfg.tol, "GBS tolerance")
           ->capture_default_str()
           ->check(nystrom::cli::tolerance_check());

@@ -26,13 +26,15 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
       ->capture_default_str();
   app.add_option("--n", o->req.n, "nbody: number of particles of the Plummer sphere")
       ->capture_default_str()
-      ->check(CLI::Range(2L, 1000000L));
+      ->check(nystrom::cli::range_check(2, 1000000));
   app.add_option("--seed", o->req.seed, "nbody: seed of the Plummer sample")->capture_default_str();
   app.add_option("--ic", o->req.ic_file, "nbody: particle file (m x y z vx vy vz per line)");
   app.add_option("--eps2", o->req.eps2, "nbody: softening squared (default (1/N)^2; twobody 0)")
-      ->check(CLI::NonNegativeNumber);
-  app.add_option("--h", o->req.h, "nbody: step size")->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--steps", o->req.steps, "nbody: number of steps")->capture_default_str()->check(CLI::PositiveNumber);
+      ->check(nystrom::cli::non_negative_check());
+  app.add_option("--h", o->req.h, "nbody: step size")->capture_default_str()->check(nystrom::cli::positive_check());
+  app.add_option("--steps", o->req.steps, "nbody: number of steps")
+      ->capture_default_str()
+      ->check(nystrom::cli::positive_check());
   app.add_option("--ecc", o->req.ecc, "Kepler eccentricity, 0 <= e < 1")
       ->capture_default_str()
       ->check(nystrom::cli::eccentricity_check());
@@ -40,10 +42,10 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
                  "Method name or spec (see `nystrom methods`; with --restart, the checkpoint's)");
   app.add_option("--steps-per-period", o->req.steps_per_period, "Steps per orbital period")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(nystrom::cli::positive_check());
   app.add_option("--periods", o->req.periods, "Number of whole periods")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(nystrom::cli::positive_check());
   app.add_option("--precision", o->req.precision, "Scalar type (double, long-double, ...)")->capture_default_str();
   app.add_option("--tol", o->req.tol, "Tolerance of an adaptive method (e.g. DP12-adaptive)")
       ->check(nystrom::cli::tolerance_check());
@@ -71,6 +73,7 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
       std::cout << j.dump(2) << "\n";  // with or without --json: output times and events do not fit the table
       return 0;
     }
+    o->req.progress = true;  // on a terminal, for a run that lasts more than a second
     const auto r = nystrom::cli::run_case(o->req, def);
     if (o->json) {
       std::cout << r.to_json().dump(2) << "\n";

@@ -32,13 +32,15 @@ nystrom::cli::Registrar reg(
       auto o = std::make_shared<Options>();
       o->base.periods = 1;
       app.add_option("--problem", o->base.problem, "Problem (kepler, harmonic, twobody, nbody)")->capture_default_str();
-      app.add_option("--n", o->base.n, "nbody: particles")->capture_default_str()->check(CLI::Range(2L, 1000000L));
+      app.add_option("--n", o->base.n, "nbody: particles")
+          ->capture_default_str()
+          ->check(nystrom::cli::range_check(2, 1000000));
       app.add_option("--seed", o->base.seed, "nbody: Plummer seed")->capture_default_str();
       app.add_option("--ic", o->base.ic_file, "nbody: particle file");
-      app.add_option("--eps2", o->base.eps2, "nbody: softening squared")->check(CLI::NonNegativeNumber);
+      app.add_option("--eps2", o->base.eps2, "nbody: softening squared")->check(nystrom::cli::non_negative_check());
       app.add_option("--t-end", o->t_end, "nbody: time span of each run (N counts forces over it)")
           ->capture_default_str()
-          ->check(CLI::PositiveNumber);
+          ->check(nystrom::cli::positive_check());
       app.add_option("--ecc", o->base.ecc, "Kepler eccentricity")->capture_default_str()->check(eccentricity_check());
       app.add_option("--methods", o->methods, "Comma-separated methods")->capture_default_str();
       app.add_option("--force-evals", o->evals, "FROM:TO:COUNT force evaluations per period (log-spaced)")
@@ -46,7 +48,7 @@ nystrom::cli::Registrar reg(
       app.add_option("--tols", o->tols, "FROM:TO:COUNT tolerances for adaptive methods");
       app.add_option("--periods", o->base.periods, "Periods integrated per run")
           ->capture_default_str()
-          ->check(CLI::PositiveNumber);
+          ->check(nystrom::cli::positive_check());
       app.add_option("--precision", o->base.precision, "Scalar type")->capture_default_str();
       app.add_option("--error", o->metric,
                      "Error measure: precession (default for kepler), position (default otherwise), energy");

@@ -1,7 +1,12 @@
 #include "runner.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 #include "cli.hpp"
@@ -15,7 +20,36 @@ namespace {
 
 nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
+double seconds_now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 }  // namespace
+
+RunMeter::RunMeter(long expected, double cost) : expected_(std::max(expected, 1L)), start_(seconds_now()) {
+  const char* env = std::getenv("NYSTROM_PROGRESS");
+  immediate_ = env && std::strcmp(env, "1") == 0;
+  const bool enabled = immediate_ || (!env && ::isatty(STDERR_FILENO));
+  // about 20 microseconds of work between two looks at the clock (a double Kepler force takes a few ns)
+  interval_ = enabled ? std::max(1L, static_cast<long>(5000 / std::max(cost, 1.0))) : std::numeric_limits<long>::max();
+  if (enabled) line_ = std::make_unique<Progress>("run", expected_);
+}
+
+RunMeter::~RunMeter() = default;
+
+long RunMeter::tick() {
+  done_ += interval_;
+  if (line_ && (shown_ || immediate_ || seconds_now() - start_ >= 1)) {
+    line_->tick(std::min(done_, expected_ - 1));  // complete only when finish() says so
+    shown_ = true;
+  }
+  return interval_;
+}
+
+void RunMeter::finish() {
+  if (line_ && shown_) line_->tick(expected_);
+  line_.reset();
+}
 
 // Defined in runner_typed.hpp, instantiated for each precision in runner_<precision>.cpp.
 template <class T>

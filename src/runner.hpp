@@ -3,6 +3,7 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -26,6 +27,47 @@ struct RunRequest {
   double eps2 = -1;         // softening squared; < 0: (1/N)^2 for nbody, 0 for twobody
   double h = 0.01;          // nbody: step size (time units)
   long steps = 100;         // nbody: number of steps
+  bool progress = false;    // a progress line on a terminal (RunMeter) for a long fixed-step Kepler/harmonic run
+};
+
+class Progress;
+
+/// The progress of one run, measured in force evaluations: MeteredForce calls tick() every interval()
+/// evaluations, which reads the clock and, once the run has lasted a second, draws the progress line
+/// (Progress: on a terminal or with NYSTROM_PROGRESS=1, which draws from the start). `expected` is the
+/// number of force evaluations the run will make, `cost` the relative cost of one (precision_cost).
+class RunMeter {
+ public:
+  RunMeter(long expected, double cost);
+  RunMeter(const RunMeter&) = delete;
+  RunMeter& operator=(const RunMeter&) = delete;
+  ~RunMeter();
+  /// interval() more evaluations were made; returns how many to make before the next call.
+  long tick();
+  /// Evaluations between two ticks: about 20 microseconds of work, at least one.
+  long interval() const { return interval_; }
+  /// The run is over: the line shows it complete (if it was drawn).
+  void finish();
+
+ private:
+  long expected_, interval_, done_ = 0;
+  double start_;
+  bool immediate_ = false, shown_ = false;
+  std::unique_ptr<Progress> line_;
+};
+
+/// A force that counts its evaluations for a RunMeter (none: never calls it) and otherwise is `F`: the
+/// same operations in the same order, so results are bitwise those of `F`.
+template <class F>
+struct MeteredForce {
+  F f;
+  RunMeter* meter = nullptr;
+  mutable long left = meter ? meter->interval() : std::numeric_limits<long>::max();
+  template <class Q, class A>
+  void operator()(const Q& q, A& a) const {
+    f(q, a);
+    if (--left == 0) left = meter ? meter->tick() : std::numeric_limits<long>::max();
+  }
 };
 
 /// The Gragg-Bulirsch-Stoer reference integrator is a method of `run`/`sweep` too, named "GBS"

@@ -2,9 +2,11 @@
 // translation unit (runner_<precision>.cpp), so that the precisions compile in parallel.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <optional>
 #include <string>
 
 #include "cli.hpp"
@@ -19,6 +21,9 @@ namespace nystrom::cli {
 
 namespace detail {
 
+// The force evaluations a fixed-step run of n steps makes (for the progress line; FSAL accounted).
+inline long expected_evals(const MethodDef& def, long n) { return n * std::max(1, def.info.forces_per_step); }
+
 template <class T>
 RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
   HarmonicProblem<T> prob;
@@ -26,8 +31,12 @@ RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
   const T h = HarmonicProblem<T>::period() / T(req.steps_per_period);
   auto s = prob.initial_state();
   const auto t0 = std::chrono::steady_clock::now();
-  RealStateIntegrator<std::array<T, 1>, HarmonicForce> integ(def, HarmonicForce{}, EngineOptions{req.keep_complex});
+  std::optional<RunMeter> meter;
+  if (req.progress) meter.emplace(expected_evals(def, n), precision_cost(req.precision));
+  RealStateIntegrator<std::array<T, 1>, MeteredForce<HarmonicForce>> integ(
+      def, MeteredForce<HarmonicForce>{HarmonicForce{}, meter ? &*meter : nullptr}, EngineOptions{req.keep_complex});
   integ.integrate(s, h, n);
+  if (meter) meter->finish();
   const long evals = integ.force_evals();
   const auto t1 = std::chrono::steady_clock::now();
   RunReport r;
@@ -43,6 +52,33 @@ RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
   return r;
 }
 
+// run_kepler (experiments/kepler.hpp) with the force counted for the progress line: the same steps and
+// results.
+template <class T>
+KeplerRunResult run_kepler_metered(const MethodDef& def, const RunRequest& req) {
+  const KeplerProblem<T> prob(static_cast<T>(req.ecc));
+  const long n = req.steps_per_period * req.periods;
+  const T h = KeplerProblem<T>::period() / T(req.steps_per_period);
+  const auto s0 = prob.initial_state();
+  State<std::array<T, 2>> s = s0;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::optional<RunMeter> meter;
+  if (req.progress) meter.emplace(expected_evals(def, n), precision_cost(req.precision));
+  RealStateIntegrator<std::array<T, 2>, MeteredForce<KeplerForce>> integ(
+      def, MeteredForce<KeplerForce>{KeplerForce{}, meter ? &*meter : nullptr}, EngineOptions{req.keep_complex});
+  integ.integrate(s, h, n);
+  if (meter) meter->finish();
+  const long evals = integ.force_evals();
+  const auto t1 = std::chrono::steady_clock::now();
+  KeplerRunResult r;
+  r.steps = n;
+  r.force_evals = evals;
+  r.h = as_double(h);
+  r.seconds = std::chrono::duration<double>(t1 - t0).count();
+  nystrom::detail::kepler_diagnostics(r, prob, s0, s, h * T(n), req.periods);
+  return r;
+}
+
 }  // namespace detail
 
 /// Kepler or harmonic run of `def` in scalar type T (validated request; GBS when `gbs`).
@@ -54,8 +90,7 @@ RunReport run_in_precision(const RunRequest& req, const MethodDef& def, bool gbs
       throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
     const auto k = gbs                 ? run_kepler_gbs<T>(req.ecc, req.tol, req.periods)
                    : def.info.adaptive ? run_kepler_adaptive<T>(def, req.ecc, req.tol, req.periods)
-                                       : run_kepler<T>(def, req.ecc, req.steps_per_period, req.periods,
-                                                       EngineOptions{req.keep_complex});
+                                       : detail::run_kepler_metered<T>(def, req);
     RunReport out;
     out.ecc = req.ecc;
     out.steps = k.steps;

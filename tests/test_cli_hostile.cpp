@@ -54,14 +54,14 @@ std::set<std::string> listing(const fs::path& dir) {
 }
 
 // Starts the tool with argv in `dir`/run; returns its pid. stdout and stderr go to files in `dir`.
-pid_t start(const fs::path& dir, const std::vector<std::string>& args) {
+pid_t start(const fs::path& dir, const std::vector<std::string>& args, const std::string& progress = "0") {
   std::vector<std::string> argv_s{tool()};
   argv_s.insert(argv_s.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : argv_s) argv.push_back(a.data());
   argv.push_back(nullptr);
   std::vector<std::string> env_s{"TMPDIR=" + (dir / "tmp").string(), "PATH=" + std::string(std::getenv("PATH")),
-                                 "NYSTROM_PROGRESS=0", "HOME=" + dir.string()};
+                                 "NYSTROM_PROGRESS=" + progress, "HOME=" + dir.string()};
   std::vector<char*> env;
   for (auto& e : env_s) env.push_back(e.data());
   env.push_back(nullptr);
@@ -292,6 +292,59 @@ TEST(CliHostile, MalformedInvocationsAreRefusedWithOneLine) {
   fs::remove_all(dir);
 }
 
+TEST(CliHostile, OutOfRangeNumbersGetOneShortLine) {
+  // every range check of a numeric option: one short line naming the option and the value given (not the
+  // bounds of a double written out in hundreds of digits)
+  const auto dir = work_dir();
+  const std::vector<std::vector<std::string>> cases = {
+      {"run", "--problem", "nbody", "--method", "LF", "--eps2", "-5"},
+      {"run", "--problem", "nbody", "--method", "LF", "--h", "-1"},
+      {"run", "--problem", "nbody", "--method", "LF", "--h", "0"},
+      {"run", "--problem", "nbody", "--method", "LF", "--steps", "0"},
+      {"run", "--problem", "nbody", "--method", "LF", "--n", "1"},
+      {"run", "--method", "FR", "--steps-per-period", "-7"},
+      {"run", "--method", "FR", "--periods", "0"},
+      {"run", "--method", "FR", "--ecc", "-0.5"},
+      {"run", "--method", "DP12-adaptive", "--tol", "-1"},
+      {"sweep", "--methods", "FR", "--force-evals", "1e3:1e3:1", "--problem", "nbody", "--eps2", "-1"},
+      {"sweep", "--methods", "FR", "--force-evals", "1e3:1e3:1", "--problem", "nbody", "--n", "1"},
+      {"sweep", "--methods", "FR", "--force-evals", "1e3:1e3:1", "--t-end", "0"},
+      {"sweep", "--methods", "FR", "--force-evals", "1e3:1e3:1", "--periods", "-1"},
+      {"cputime", "--n", "1"},
+      {"cputime", "--n", "10", "--eps", "-1"},
+      {"cputime", "--n", "10", "--threads", "5000"},
+      {"cputime", "--n", "10", "--h", "-0.1"},
+      {"cputime", "--n", "10", "--steps", "0"},
+      {"cputime", "--n", "10", "--repeats", "1001"},
+      {"localerr", "--methods", "LF", "--n", "1"},
+      {"localerr", "--methods", "LF", "--n", "10", "--eps", "-1"},
+      {"localerr", "--methods", "LF", "--n", "10", "--threads", "5000"},
+      {"localerr", "--methods", "LF", "--n", "10", "--duration", "0"},
+      {"discover", "--starts", "0"},
+      {"discover", "--threads", "300"},
+      {"discover", "--box", "1e7"},
+      {"discover", "--polish-bits", "8"},
+      {"discover", "--tries", "0"},
+      {"discover", "--perturbation", "-1"},
+      {"discover", "--six-bits", "5000"},
+      {"bench-peers", "--periods", "0"},
+  };
+  for (const auto& args : cases) {
+    const Result r = run(dir, args);
+    expect_refused(r, joined(args));
+    EXPECT_LE(r.err.size(), 121u) << joined(args) << ": " << r.err;
+    EXPECT_NE(r.err.find(args.back()), std::string::npos) << joined(args) << ": the value is named: " << r.err;
+    EXPECT_NE(r.err.find(args[args.size() - 2]), std::string::npos) << joined(args) << ": the option: " << r.err;
+  }
+  // a malformed value of a range-checked option is a syntax error, not a range error
+  for (const std::string v : {"nan", "inf", "", "-5x", "1e999"}) {
+    const Result r = run(dir, {"run", "--problem", "nbody", "--method", "LF", "--eps2", v});
+    expect_refused(r, "--eps2 " + v);
+    EXPECT_LE(r.err.size(), 121u) << r.err;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(CliHostile, NestedAdjointsResolveByParity) {
   const auto dir = work_dir();
   // an even nesting is the method itself, an odd one its adjoint; both without recursion
@@ -383,5 +436,74 @@ TEST(CliHostile, SigtermStopsALongRunAndRemovesTemporaryFiles) {
   EXPECT_EQ(r.code, 128 + SIGTERM) << r.err;
   EXPECT_EQ(listing(dir / "run"), std::set<std::string>{});
   EXPECT_EQ(listing(dir / "tmp"), std::set<std::string>{});
+  fs::remove_all(dir);
+}
+
+// Waits up to `limit` for `path` to contain `text`; true when it does.
+bool wait_for_text(const fs::path& path, const std::string& text, std::chrono::seconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < end) {
+    if (slurp(path).find(text) != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+// The status of `pid` once it ends; SIGKILL and -1 if it has not ended within `limit` (it did not stop).
+int wait_or_kill(pid_t pid, std::chrono::seconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  int status = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    const pid_t r = ::waitpid(pid, &status, WNOHANG);
+    if (r == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &status, 0);
+  return -1;
+}
+
+TEST(CliHostile, SigintStopsALongRunWithProgressAndLeavesNoFile) {
+  const auto dir = work_dir();
+  // a Kepler run of about 1.5e10 force evaluations (minutes): its progress line (forced on with
+  // NYSTROM_PROGRESS=1) shows an estimate of the time left; SIGINT ends it with the signal's status, the
+  // one-line message and no result on stdout
+  const pid_t pid = start(dir, {"run", "--method", "M8", "--steps-per-period", "1000000", "--periods", "1000"}, "1");
+  const bool progress = wait_for_text(dir / "stderr.txt", "ETA", std::chrono::seconds(60));
+  EXPECT_TRUE(progress) << "no progress line: " << slurp(dir / "stderr.txt");
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  // promptly: the run had minutes left; the limit only keeps a failing test from hanging
+  const int code = wait_or_kill(pid, std::chrono::seconds(30));
+  EXPECT_EQ(code, 128 + SIGINT) << "the run did not stop on SIGINT";
+  const std::string err = slurp(dir / "stderr.txt");
+  EXPECT_NE(err.find("run ["), std::string::npos) << err;
+  const std::string last = "nystrom: error: interrupted\n";
+  ASSERT_GE(err.size(), last.size());
+  EXPECT_EQ(err.substr(err.size() - last.size()), last);
+  EXPECT_EQ(slurp(dir / "stdout.txt"), "");
+  EXPECT_EQ(listing(dir / "run"), std::set<std::string>{});
+  EXPECT_EQ(listing(dir / "tmp"), std::set<std::string>{});
+  fs::remove_all(dir);
+}
+
+TEST(CliHostile, SigintAfterACheckpointKeepsItWhole) {
+  const auto dir = work_dir();
+  // 1e7 steps of M8 (1e8 force evaluations) with a checkpoint at t = 1 of a span of 2000 pi: interrupted as soon
+  // as the checkpoint is there, the run leaves it complete (it reads back), and nothing else
+  const pid_t pid = start(dir, {"run", "--method", "M8", "--steps-per-period", "10000", "--periods", "1000",
+                                "--checkpoint", "cp.txt", "--checkpoint-at", "1"});
+  const bool written = wait_for_text(dir / "run" / "cp.txt", "\n", std::chrono::seconds(60));
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  const int code = wait_or_kill(pid, std::chrono::seconds(30));
+  ASSERT_TRUE(written) << slurp(dir / "stderr.txt");
+  EXPECT_EQ(code, 128 + SIGINT) << "the run did not stop on SIGINT";
+  EXPECT_EQ(slurp(dir / "stdout.txt"), "");
+  EXPECT_EQ(listing(dir / "run"), std::set<std::string>{"cp.txt"});
+  EXPECT_EQ(listing(dir / "tmp"), std::set<std::string>{});
+  // the checkpoint names its method: the run restarts from it (one period, so that it ends at once)
+  fs::rename(dir / "run" / "cp.txt", dir / "cp.txt");
+  const Result r = run(
+      dir, {"run", "--restart", (dir / "cp.txt").string(), "--steps-per-period", "10000", "--periods", "1", "--json"});
+  EXPECT_EQ(r.code, 0) << r.err;
   fs::remove_all(dir);
 }
