@@ -206,9 +206,16 @@ O plain_options(O o) {
 // (EngineOptions::mpe_schedule); "sequential" forces one product after the other, as the hand loops do.
 bool is_mpe(const Case& c) { return std::string(c.method).rfind("M", 0) == 0 && std::string(c.method) != "M4-RKN"; }
 
-void bm_library(benchmark::State& state, const Case& c, bool plain, bool sequential = false) {
-  EngineOptions opt = plain ? plain_options(EngineOptions{}) : EngineOptions{};
-  if (sequential) opt.mpe_schedule = MpeSchedule::sequential;
+// How the library is run: plain = compensated summation off, as in the hand-written loops; sequential = the
+// products of a multi-product method one after the other.
+struct LibraryRun {
+  bool plain = false;
+  bool sequential = false;
+};
+
+void bm_library(benchmark::State& state, const Case& c, LibraryRun run) {
+  EngineOptions opt = run.plain ? plain_options(EngineOptions{}) : EngineOptions{};
+  if (run.sequential) opt.mpe_schedule = MpeSchedule::sequential;
   auto integ = make_integrator<V>(resolve_method(c.method), KeplerForce{}, opt);
   const double h = step_size();
   const State<V> s0 = start();
@@ -275,7 +282,7 @@ class SummaryReporter : public bench::MinTimeReporter {
     }
     std::printf("(target: library / hand-written <= 1.10%s)\n",
                 plain ? "; 'plain' = the library with compensated summation off, as the hand-written loops" : "");
-    // Issue 8: an M8 step (10 forces, products in lockstep) against 10 sequential force evaluations, i.e.
+    // An M8 step (10 forces, products in lockstep) against 10 sequential force evaluations, i.e.
     // 10 steps of the hand-written velocity Verlet loop (one force per step, each depending on the last).
     const double *vv = best("hand/VV"), *m8 = best("library-plain/M8"), *m8s = best("library-plain-sequential/M8");
     if (vv && m8) {
@@ -295,15 +302,15 @@ int main(int argc, char** argv) {
       bm_hand(s, c);
     })->MinTime(0.2);
     benchmark::RegisterBenchmark((std::string("library/") + c.name).c_str(), [&c](benchmark::State& s) {
-      bm_library(s, c, false);
+      bm_library(s, c, {});
     })->MinTime(0.2);
     if (has_compensation_option<EngineOptions>)
       benchmark::RegisterBenchmark((std::string("library-plain/") + c.name).c_str(), [&c](benchmark::State& s) {
-        bm_library(s, c, true);
+        bm_library(s, c, {.plain = true});
       })->MinTime(0.2);
     if (is_mpe(c) && has_compensation_option<EngineOptions>)
       benchmark::RegisterBenchmark((std::string("library-plain-sequential/") + c.name).c_str(),
-                                   [&c](benchmark::State& s) { bm_library(s, c, true, true); })
+                                   [&c](benchmark::State& s) { bm_library(s, c, {.plain = true, .sequential = true}); })
           ->MinTime(0.2);
   }
   if (!bench::initialize({argv, argv + argc}, 5)) return 1;  // five repetitions unless told otherwise

@@ -14,7 +14,8 @@ if(NOT TARGET nystrom_deps)
   add_library(nystrom_deps INTERFACE)
   target_include_directories(nystrom_deps INTERFACE ${GMPXX_INCLUDE_DIR} ${MPFR_INCLUDE_DIR} ${QD_INCLUDE_DIR})
   # libquadmath ships with GCC (not in the default library path): link it by name.
-  target_link_libraries(nystrom_deps INTERFACE Boost::headers ${QD_LIBRARY} ${MPFR_LIBRARY} ${GMPXX_LIBRARY} ${GMP_LIBRARY} quadmath)
+  target_link_libraries(nystrom_deps INTERFACE Boost::headers ${QD_LIBRARY} ${MPFR_LIBRARY} ${GMPXX_LIBRARY}
+                                                ${GMP_LIBRARY} quadmath)
 endif()
 
 # FFTW for the quantum layer (include/nystrom/quantum): fftw3 (double) and fftw3l (long double), with

@@ -17,7 +17,7 @@ int main() {
   std::vector<double> times;
   for (int i = 0; i <= 10; ++i) times.push_back(5.0 * i);
   const std::vector<nystrom::Event<V>> events = {
-      {"bottom", [](double, const V& q, const V&) { return q[0]; }, +1, false}};
+      {.name = "bottom", .g = [](double, const V& q, const V&) { return q[0]; }, .direction = +1}};
 
   const auto sol = nystrom::solve(problem, "M12-adaptive", {.rtol = 1e-12, .t_eval = times}, events);
 

@@ -73,13 +73,13 @@ std::string errno_text(int e) { return std::strerror(e); }
 
 }  // namespace
 
-TempFile::TempFile(std::string path, bool directory) : path_(std::move(path)), directory_(directory) {
+TempFile::TempFile(std::string path, Kind kind) : path_(std::move(path)), directory_(kind == Kind::directory) {
   if (path_.size() >= kPathMax) return;
   for (int i = 0; i < kSlots; ++i)
     if (g_kind[i] == 0) {
       std::memcpy(g_paths[i], path_.c_str(), path_.size() + 1);
       std::atomic_signal_fence(std::memory_order_seq_cst);
-      g_kind[i] = directory ? 2 : 1;
+      g_kind[i] = directory_ ? 2 : 1;
       slot_ = i;
       break;
     }
@@ -200,7 +200,8 @@ void write_file_atomic(const std::string& path, const std::string& content) {
 // ---------------------------------------------------------------------------------------------------------
 // Numbers.
 
-std::string number_syntax_error(std::string_view t, bool integer) {
+std::string number_syntax_error(std::string_view t, NumberSyntax syntax) {
+  const bool integer = syntax == NumberSyntax::integer;
   if (t.empty()) return "an empty string is not a number";
   std::size_t i = 0;
   if (t[i] == '+' || t[i] == '-') ++i;
@@ -222,8 +223,8 @@ std::string number_syntax_error(std::string_view t, bool integer) {
   return "";
 }
 
-double parse_double(const std::string& text, const std::string& what, bool positive) {
-  if (const auto err = number_syntax_error(text, false); !err.empty())
+double parse_double(const std::string& text, const std::string& what, Bound bound) {
+  if (const auto err = number_syntax_error(text, NumberSyntax::decimal); !err.empty())
     throw UsageError(what + " must be a number, got '" + text + "'");
   errno = 0;
   char* end = nullptr;
@@ -232,12 +233,13 @@ double parse_double(const std::string& text, const std::string& what, bool posit
   if (!std::isfinite(v) || (errno == ERANGE && std::abs(v) > 1))
     throw UsageError(what + " must be finite, got '" + text + "'");
   if (errno == ERANGE) throw UsageError(what + " is too small to represent, got '" + text + "'");
-  if (positive && !(v > 0)) throw UsageError(what + " must be positive, got '" + text + "'");
+  if (bound == Bound::positive && !(v > 0)) throw UsageError(what + " must be positive, got '" + text + "'");
   return v;
 }
 
 long long parse_integer(const std::string& text, const std::string& what, long long lo, long long hi) {
-  if (!number_syntax_error(text, true).empty()) throw UsageError(what + " must be a whole number, got '" + text + "'");
+  if (!number_syntax_error(text, NumberSyntax::integer).empty())
+    throw UsageError(what + " must be a whole number, got '" + text + "'");
   long long v = 0;
   const char* b = text.c_str() + (text[0] == '+' ? 1 : 0);
   const auto [ptr, ec] = std::from_chars(b, text.c_str() + text.size(), v);
@@ -259,11 +261,18 @@ namespace {
 // The value as quoted in a message: at most 40 characters.
 std::string shown(const std::string& v) { return "'" + (v.size() > 40 ? v.substr(0, 40) + "..." : v) + "'"; }
 
+// What a numeric option accepts: its syntax, and whether a minus sign is refused.
+struct NumberRule {
+  NumberSyntax syntax = NumberSyntax::decimal;
+  bool non_negative = false;
+};
+
 // The syntax check of every numeric option: an empty string when `v` is a valid number of its kind.
-std::string strict_number_error(const std::string& v, bool integer, bool unsigned_) {
-  if (const auto err = number_syntax_error(v, integer); !err.empty())
+std::string strict_number_error(const std::string& v, NumberRule rule) {
+  const bool integer = rule.syntax == NumberSyntax::integer;
+  if (const auto err = number_syntax_error(v, rule.syntax); !err.empty())
     return "must be " + std::string(integer ? "a whole number" : "a finite number") + ", got " + shown(v);
-  if (unsigned_ && v[0] == '-') return "must not be negative, got " + shown(v);
+  if (rule.non_negative && v[0] == '-') return "must not be negative, got " + shown(v);
   if (integer) {
     long long x = 0;
     const char* b = v.c_str() + (v[0] == '+' ? 1 : 0);
@@ -282,11 +291,15 @@ std::string bound_text(double x) {
   return x == std::floor(x) && std::abs(x) < 1e15 ? fmt::format("{:.0f}", x) : fmt::format("{:g}", x);
 }
 
-// A range check: the syntax of a number, then lo <= x <= hi (lo_open: lo < x).
-CLI::Validator bounded(double lo, bool lo_open, double hi, std::string description) {
+// Whether the lower end of a range check belongs to the range.
+enum class LowerEnd { closed, open };
+
+// A range check: the syntax of a number, then lo <= x <= hi (LowerEnd::open: lo < x).
+CLI::Validator bounded(double lo, LowerEnd end, double hi, std::string description) {
+  const bool lo_open = end == LowerEnd::open;
   return CLI::Validator(
       [lo, lo_open, hi](std::string& v) -> std::string {
-        if (auto err = strict_number_error(v, false, false); !err.empty()) return err;
+        if (auto err = strict_number_error(v, {}); !err.empty()) return err;
         const double x = std::strtod(v.c_str(), nullptr);
         if ((lo_open ? x > lo : x >= lo) && x <= hi) return "";
         if (lo == 0 && std::isinf(hi))
@@ -298,16 +311,16 @@ CLI::Validator bounded(double lo, bool lo_open, double hi, std::string descripti
 
 }  // namespace
 
-CLI::Validator positive_check() { return bounded(0, true, HUGE_VAL, "POSITIVE"); }
-CLI::Validator non_negative_check() { return bounded(0, false, HUGE_VAL, "NONNEGATIVE"); }
+CLI::Validator positive_check() { return bounded(0, LowerEnd::open, HUGE_VAL, "POSITIVE"); }
+CLI::Validator non_negative_check() { return bounded(0, LowerEnd::closed, HUGE_VAL, "NONNEGATIVE"); }
 CLI::Validator range_check(double lo, double hi) {
-  return bounded(lo, false, hi, "[" + bound_text(lo) + " - " + bound_text(hi) + "]");
+  return bounded(lo, LowerEnd::closed, hi, "[" + bound_text(lo) + " - " + bound_text(hi) + "]");
 }
 
 CLI::Validator eccentricity_check() {
   return CLI::Validator(
       [](std::string& v) -> std::string {
-        if (auto err = strict_number_error(v, false, false); !err.empty()) return err;
+        if (auto err = strict_number_error(v, {}); !err.empty()) return err;
         const double e = std::strtod(v.c_str(), nullptr);
         return e >= 0 && e < 1 ? "" : "the eccentricity must satisfy 0 <= e < 1, got " + shown(v);
       },
@@ -317,7 +330,7 @@ CLI::Validator eccentricity_check() {
 CLI::Validator tolerance_check() {
   return CLI::Validator(
       [](std::string& v) -> std::string {
-        if (auto err = strict_number_error(v, false, false); !err.empty()) return err;
+        if (auto err = strict_number_error(v, {}); !err.empty()) return err;
         const double t = std::strtod(v.c_str(), nullptr);
         return t >= 1e-300 && t < 1e300 ? "" : "the tolerance must be positive (at least 1e-300), got " + shown(v);
       },
@@ -369,17 +382,17 @@ std::string printable(std::string_view text, std::size_t max) {
   return out;
 }
 
-std::vector<double> parse_log_range(const std::string& text, const std::string& what, bool allow_decreasing) {
+std::vector<double> parse_log_range(const std::string& text, const std::string& what, RangeOrder order) {
   std::vector<std::string> parts;
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ':')) parts.push_back(item);
   if (parts.size() != 3 || text.empty() || text.back() == ':')
     throw UsageError(what + " must be FROM:TO:COUNT (e.g. 1e3:1e6:20), got '" + text + "'");
-  const double lo = parse_double(parts[0], what + " start", true);
-  const double hi = parse_double(parts[1], what + " end", true);
+  const double lo = parse_double(parts[0], what + " start", Bound::positive);
+  const double hi = parse_double(parts[1], what + " end", Bound::positive);
   const int n = static_cast<int>(parse_integer(parts[2], what + " count", 1, 10000));
-  if (hi < lo && !allow_decreasing) throw UsageError(what + ": end must not be below start");
+  if (hi < lo && order == RangeOrder::increasing) throw UsageError(what + ": end must not be below start");
   std::vector<double> v;
   for (int i = 0; i < n; ++i)
     v.push_back(n == 1 ? lo : std::exp(std::log(lo) + (std::log(hi) - std::log(lo)) * i / (n - 1)));
@@ -558,7 +571,7 @@ void plot_xy(const std::string& png_path, const std::string& title, const std::s
   std::string tmpl = (fs::path(tmp_env && *tmp_env == '/' ? tmp_env : "/tmp") / "nystrom-plot.XXXXXX").string();
   if (tmpl.size() >= kPathMax - 32 || !::mkdtemp(tmpl.data()))
     throw UsageError("cannot create a temporary folder for the plot: " + errno_text(errno));
-  TempFile dir(tmpl, true);
+  TempFile dir(tmpl, TempFile::Kind::directory);
   // the files inside are registered before they exist, so the signal handler removes whichever were made
   TempFile script_file(tmpl + "/plot.gp"), png_file(tmpl + "/plot.png"), log_file(tmpl + "/gnuplot.log");
   {
@@ -595,7 +608,10 @@ void add_strict_validators(CLI::App& app) {
       const bool integer = type != "FLOAT";
       const bool unsigned_ = type == "UINT";
       opt->check(CLI::Validator(
-          [integer, unsigned_](std::string& v) -> std::string { return strict_number_error(v, integer, unsigned_); },
+          [integer, unsigned_](std::string& v) -> std::string {
+            return strict_number_error(
+                v, {.syntax = integer ? NumberSyntax::integer : NumberSyntax::decimal, .non_negative = unsigned_});
+          },
           "", "strict number"));
     } else if (type == "TEXT") {
       opt->check(CLI::Validator([](std::string& v) -> std::string { return v.empty() ? "must not be empty" : ""; }, "",

@@ -65,9 +65,12 @@ int run_main(int argc, char** argv);
 /// `text` with every byte outside printable ASCII written as \xNN (and \n, \t, \\), cut to `max` characters.
 std::string printable(std::string_view text, std::size_t max = 400);
 
+/// Which numbers a text may spell: decimal ones, or integers (no fraction, no exponent).
+enum class NumberSyntax : unsigned char { decimal, integer };
+
 /// Strict syntax of a decimal number: [+-]digits[.digits][(e|E)[+-]digits] (or .digits); no spaces, no
 /// hex, inf or nan. Returns an empty string when `text` is valid, otherwise what is wrong.
-std::string number_syntax_error(std::string_view text, bool integer);
+std::string number_syntax_error(std::string_view text, NumberSyntax syntax);
 
 /// Parses a whole-string integer (no exponent or fraction) within [lo, hi]; `what` names it in errors.
 long long parse_integer(const std::string& text, const std::string& what, long long lo, long long hi);
@@ -98,7 +101,8 @@ double precision_cost(const std::string& precision);
 class TempFile {
  public:
   TempFile() = default;
-  explicit TempFile(std::string path, bool directory = false);
+  enum class Kind : unsigned char { file, directory };
+  explicit TempFile(std::string path, Kind kind = Kind::file);
   TempFile(const TempFile&) = delete;
   TempFile& operator=(const TempFile&) = delete;
   ~TempFile();
@@ -127,12 +131,18 @@ struct Registrar {
 /// path and a folder; errors carry the system's reason.
 void write_file_atomic(const std::string& path, const std::string& content);
 
-/// Parses a number that must be finite (and positive if `positive`); `what` names it in errors.
-double parse_double(const std::string& text, const std::string& what, bool positive = false);
+/// What a parsed number must be: finite, or finite and positive.
+enum class Bound : unsigned char { finite, positive };
+
+/// Parses a number that must satisfy `bound`; `what` names it in errors.
+double parse_double(const std::string& text, const std::string& what, Bound bound = Bound::finite);
+
+/// The order of the ends of a range FROM:TO:COUNT: TO at least FROM, or either way (e.g. tolerances 1e-6:1e-14:9).
+enum class RangeOrder : unsigned char { increasing, either };
 
 /// "1e3:1e6:20" -> 20 values spaced evenly in log between 1e3 and 1e6 (inclusive).
-/// With allow_decreasing, TO may be below FROM (e.g. tolerances 1e-6:1e-14:9).
-std::vector<double> parse_log_range(const std::string& text, const std::string& what, bool allow_decreasing = false);
+std::vector<double> parse_log_range(const std::string& text, const std::string& what,
+                                    RangeOrder order = RangeOrder::increasing);
 
 /// Splits "a,b,c"; empty items are errors.
 std::vector<std::string> split_list(const std::string& text, const std::string& what);

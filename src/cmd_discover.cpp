@@ -167,9 +167,9 @@ int run_search(const Options& o) {
                      {"singular", rep.not_polished},
                      {"real", rep.count(an::MethodClass::real)},
                      {"imaginary", rep.count(an::MethodClass::imaginary)},
-                     {"imaginary_positive", rep.count(an::MethodClass::imaginary, true)},
+                     {"imaginary_positive", rep.count_positive(an::MethodClass::imaginary)},
                      {"other", rep.count(an::MethodClass::other)},
-                     {"other_positive", rep.count(an::MethodClass::other, true)},
+                     {"other_positive", rep.count_positive(an::MethodClass::other)},
                      {"rediscovered", found},
                      {"seconds", seconds},
                      {"methods", methods}});
@@ -184,8 +184,8 @@ int run_search(const Options& o) {
           rep.converged, rep.methods.size(), rep.not_polished);
       fmt::print("  REAL {}   IMAGINARY {} ({} with positive real parts)   OTHER {} ({} with positive real parts)\n",
                  rep.count(an::MethodClass::real), rep.count(an::MethodClass::imaginary),
-                 rep.count(an::MethodClass::imaginary, true), rep.count(an::MethodClass::other),
-                 rep.count(an::MethodClass::other, true));
+                 rep.count_positive(an::MethodClass::imaginary), rep.count(an::MethodClass::other),
+                 rep.count_positive(an::MethodClass::other));
       fmt::print("  {:>3} {:<5} {:>3} {:>4} {:>11} {:>8} {:>6} {:>6}  {}\n", "#", "class", "pos", "skew", "|err6|",
                  "max|c|", "hits", "digits", "published");
       int idx = 0;

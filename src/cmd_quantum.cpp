@@ -24,6 +24,7 @@ extern char** environ;
 
 namespace {
 
+using nystrom::cli::Bound;
 using nystrom::cli::UsageError;
 using namespace nystrom::quantum;
 
@@ -118,15 +119,15 @@ QuantumResult run(const Options& o) {
   QuantumProblem<R> p;
   p.dims = o.dims;
   p.grid = o.grid;
-  p.box = static_cast<R>(nystrom::cli::parse_double(o.box, "--box", true));
+  p.box = static_cast<R>(nystrom::cli::parse_double(o.box, "--box", Bound::positive));
   p.potential = o.potential;
   p.g = static_cast<R>(nystrom::cli::parse_double(o.g, "--g"));
   p.time = o.imaginary ? TimeKind::imaginary : TimeKind::real;
   for (double x : parse_vector(o.x0, "--x0", o.dims)) p.x0.push_back(static_cast<R>(x));
   for (double x : parse_vector(o.p0, "--p0", o.dims)) p.p0.push_back(static_cast<R>(x));
-  p.width = static_cast<R>(nystrom::cli::parse_double(o.width, "--width", true));
+  p.width = static_cast<R>(nystrom::cli::parse_double(o.width, "--width", Bound::positive));
   p.fft.threads = o.threads;
-  const R dt = static_cast<R>(nystrom::cli::parse_double(o.dt, "--dt", true));
+  const R dt = static_cast<R>(nystrom::cli::parse_double(o.dt, "--dt", Bound::positive));
   return solve(p, o.method, dt, o.steps, o.plot.empty() ? 0 : std::min<long>(o.steps, 400));
 }
 
@@ -138,7 +139,7 @@ nlohmann::json to_json(const Options& o, const QuantumResult& r) {
   j["potential"] = o.potential;
   j["dims"] = o.dims;
   j["grid"] = o.grid;
-  j["box"] = nystrom::cli::parse_double(o.box, "--box", true);
+  j["box"] = nystrom::cli::parse_double(o.box, "--box", Bound::positive);
   j["dt"] = r.dt;
   j["steps"] = r.steps;
   j["time"] = r.time;
@@ -186,8 +187,8 @@ nystrom::cli::Registrar reg(
         if (o->dims < 1 || o->dims > 3) throw UsageError("--dims must be 1, 2 or 3, got " + std::to_string(o->dims));
         if (o->steps < 0) throw UsageError("--steps must not be negative");
         if (o->threads < 1) throw UsageError("--threads must be positive");
-        nystrom::cli::parse_double(o->box, "--box", true);
-        nystrom::cli::parse_double(o->dt, "--dt", true);
+        nystrom::cli::parse_double(o->box, "--box", Bound::positive);
+        nystrom::cli::parse_double(o->dt, "--dt", Bound::positive);
         nystrom::cli::parse_double(o->g, "--g");
         QuantumResult r;
         if (o->precision == "double")

@@ -63,7 +63,7 @@ nystrom::cli::Registrar reg(
         req.t_end = o->t_end;
         req.methods = split_list(o->methods, "--methods");
         req.force_evals = parse_log_range(o->evals, "--force-evals");
-        if (!o->tols.empty()) req.tols = parse_log_range(o->tols, "--tols", true);
+        if (!o->tols.empty()) req.tols = parse_log_range(o->tols, "--tols", RangeOrder::either);
         if (o->metric.empty()) o->metric = req.base.problem == "kepler" ? "precession" : "position";
         if (o->metric == "precession" && req.base.problem != "kepler")
           throw UsageError("--error precession is defined for --problem kepler only");

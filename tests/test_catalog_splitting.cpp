@@ -524,7 +524,8 @@ TEST(Compositions, OrderConditionsOnGenericMatrices) {
   {
     const std::vector<bigcomplex> half = {big("0.1867"), big("0.55549702371247839916"), big("0.12946694891347535806"),
                                           big("-0.84326562338773460855"), big("0.9432033015235617027")};
-    cases.push_back({"McLachlan SS9", 6, normalized(compose(position_verlet_scheme(), palindrome(half, true)))});
+    cases.push_back(
+        {"McLachlan SS9", 6, normalized(compose(position_verlet_scheme(), palindrome(half, PalindromeLength::odd)))});
   }
   for (const auto& c : cases) {
     const LocalOrder lo = local_order(c.scheme, c.order, bigfloat(1) / (c.order >= 10 ? 64 : 32));

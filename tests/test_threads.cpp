@@ -4,8 +4,9 @@
 // single-threaded build gives them, and leave the default precision as they found it. Boost's variable is
 // atomic, so sharing it is a race of logic that ThreadSanitizer does not see; the bitwise comparison does
 // (without BigPrecision's lock this test measured thousands of mismatched coefficients, and the default
-// left at 79 digits instead of 20). The tsan preset (NYSTROM_TSAN) runs the test under ThreadSanitizer
-// too, for the data races it can see (the refinement cache, MPFR's own caches).
+// left at 79 digits instead of 20). The same variable holds the working precision of mpfr_real (MpfrPrecision,
+// core/extended.hpp), whose scope takes the same lock. The tsan preset (NYSTROM_TSAN) runs the test under
+// ThreadSanitizer too, for the data races it can see (the refinement cache, MPFR's own caches).
 #include <gtest/gtest.h>
 
 #include <mpfr.h>
@@ -88,6 +89,23 @@ State<std::array<T, 2>> run_kepler_steps(const MethodDef& def) {
   auto s = KeplerProblem<T>(T(0.5)).initial_state();
   integ.integrate(s, T(1) / T(16), 40);
   return s;
+}
+
+// An mpfr_real exactly, as text: its precision in bits and its value in hexadecimal ("%Ra" prints every bit).
+std::string exact_text(const mpfr_real& x) {
+  char* hex = nullptr;
+  if (mpfr_asprintf(&hex, "%Ra", x.backend().data()) < 0) return "(mpfr_asprintf failed)";
+  std::string out = std::to_string(mpfr_get_prec(x.backend().data())) + " bits " + hex;
+  mpfr_free_str(hex);
+  return out;
+}
+
+// A method's final state after Kepler steps in mpfr_real at `bits`: the scope is opened, the integrator built
+// and run, and the state written out exactly before the scope ends.
+std::vector<std::string> mpfr_kepler_steps(const MethodDef& def, long bits) {
+  const MpfrPrecision scope(bits);
+  const auto s = run_kepler_steps<mpfr_real>(def);
+  return {exact_text(s.q[0]), exact_text(s.q[1]), exact_text(s.v[0]), exact_text(s.v[1])};
 }
 
 // Bitwise equality of two states, value by value (long double's padding bytes are not part of the value).
@@ -178,4 +196,44 @@ TEST(Threads, ConcurrentIntegratorsRunBitwiseAsInOneThread) {
     EXPECT_TRUE(same_state(got_d[i], want_d[i])) << defs[i].info.name << " in double";
     EXPECT_TRUE(same_state(got_l[i], want_l[i])) << defs[i].info.name << " in long double";
   }
+}
+
+// Threads that each open an MpfrPrecision scope at a different precision, build an integrator and run Kepler
+// steps in mpfr_real, while another thread builds coefficients at a wide reference precision: every final state
+// is bitwise (precision and value) that of the same run in one thread, and the default precision is left as it
+// was. (Without the scope's lock, a value made from T(1) or a temporary takes whichever thread's precision is
+// the default at that moment.)
+TEST(Threads, ConcurrentMpfrScopesRunBitwiseAsInOneThread) {
+  std::vector<MethodDef> defs;
+  for (const auto& name : kMethods)
+    if (!resolve_method(name).info.complex) defs.push_back(resolve_method(name));
+  ASSERT_GE(defs.size(), 5u);
+  const std::size_t n = defs.size() * kBits.size();
+  std::vector<std::vector<std::string>> want(n);
+  for (std::size_t i = 0; i < n; ++i) want[i] = mpfr_kepler_steps(defs[i / kBits.size()], kBits[i % kBits.size()]);
+  const unsigned before = bigfloat::default_precision();
+  ASSERT_EQ(MpfrPrecision::requested(), 0);
+
+  constexpr std::size_t kThreads = 4;
+  std::vector<std::vector<std::vector<std::string>>> got(kThreads, std::vector<std::vector<std::string>>(n));
+  std::vector<std::thread> pool;
+  for (std::size_t t = 0; t < kThreads; ++t)
+    pool.push_back(mpfr_thread([&, t] {
+      for (std::size_t j = 0; j < n; ++j) {
+        // Method j / 4 at precision kBits[(j + t) % 4]: the threads' scopes ask for different precisions at once.
+        const std::size_t i = j / kBits.size() * kBits.size() + (j + t) % kBits.size();
+        got[t][i] = mpfr_kepler_steps(defs[i / kBits.size()], kBits[i % kBits.size()]);
+      }
+    }));
+  pool.push_back(mpfr_thread([&] {
+    for (const auto& d : defs) method_data_for(d, 600, "wide");
+  }));
+  for (auto& th : pool) th.join();
+
+  EXPECT_EQ(bigfloat::default_precision(), before);
+  EXPECT_EQ(MpfrPrecision::requested(), 0);
+  for (std::size_t t = 0; t < kThreads; ++t)
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_EQ(got[t][i], want[i]) << defs[i / kBits.size()].info.name << " at " << kBits[i % kBits.size()]
+                                    << " bits, thread " << t;
 }

@@ -106,7 +106,7 @@ struct MethodSpec {
   int forces_extra = 0;     // fixed-step: forces of the first step beyond forces_per_step (FSAL start)
   bool compensated = true;  // nystrom: compensated summation (the default for double)
   bool reference = true;    // counts for "the best of its library" (the uncompensated variants do not)
-  std::function<Prepare(ForceCounter*)> make;  // builds what does not depend on the parameter
+  std::function<Prepare(ForceCounter*)> make{};  // builds what does not depend on the parameter
 };
 
 struct PeerRun {
@@ -163,7 +163,9 @@ inline double period() { return KeplerProblem<double>::period(); }
 
 // ---- nystrom -------------------------------------------------------------------------------------
 
-inline MethodSpec nystrom_fixed(const std::string& name, double ecc, long periods, bool compensated = true) {
+inline MethodSpec nystrom_fixed(const std::string& name, double ecc, long periods,
+                                Compensation compensation = Compensation::on) {
+  const bool compensated = compensation != Compensation::off;
   const MethodDef def = resolve_method(name);
   MethodSpec m;
   m.library = "nystrom";
@@ -223,7 +225,9 @@ inline MethodSpec nystrom_adaptive(const std::string& name, double ecc, long per
 /// An adaptive multi-product method (engines/adaptive_mpe.hpp), e.g. "M12-adaptive": products in
 /// lockstep, the same start step as DP12-adaptive; compensated summation (the default for double) or
 /// not (then a variant "(no comp.)" that does not count as the library's reference configuration).
-inline MethodSpec nystrom_adaptive_mpe(const std::string& name, double ecc, long periods, bool compensated = true) {
+inline MethodSpec nystrom_adaptive_mpe(const std::string& name, double ecc, long periods,
+                                       Compensation compensation = Compensation::on) {
+  const bool compensated = compensation != Compensation::off;
   const MethodDef def = resolve_method(name);
   MethodSpec m;
   m.library = "nystrom";
@@ -302,25 +306,12 @@ inline State<Vec2> from_pair(const std::pair<Vec2, Vec2>& x) { return {x.first, 
 inline Vec4 to_vec4(const State<Vec2>& s) { return {s.q[0], s.q[1], s.v[0], s.v[1]}; }
 inline State<Vec2> from_vec4(const Vec4& y) { return {{y[0], y[1]}, {y[2], y[3]}}; }
 
-inline MethodSpec odeint_spec(const std::string& name, const std::string& label, bool adaptive, int order,
-                              int forces_per_step, int forces_extra) {
-  MethodSpec m;
-  m.library = "odeint";
-  m.name = name;
-  m.label = label;
-  m.adaptive = adaptive;
-  m.order = order;
-  m.forces_per_step = forces_per_step;
-  m.forces_extra = forces_extra;
-  return m;
-}
-
 /// odeint's symplectic RKN steppers on the (q, p) pair; the system is the momentum function alone
 /// (odeint then takes dq/dt = p).
 template <class Stepper>
 MethodSpec odeint_symplectic(const std::string& name, const std::string& label, int order, int forces_per_step,
                              double ecc, long periods) {
-  MethodSpec m = odeint_spec(name, label, false, order, forces_per_step, 0);
+  MethodSpec m{.library = "odeint", .name = name, .label = label, .order = order, .forces_per_step = forces_per_step};
   m.make = [ecc, periods](ForceCounter* c) -> Prepare {
     return [ecc, periods, c](double spp) -> Run {
       const long k = static_cast<long>(spp);
@@ -332,7 +323,12 @@ MethodSpec odeint_symplectic(const std::string& name, const std::string& label, 
 }
 
 inline MethodSpec odeint_verlet(double ecc, long periods) {
-  MethodSpec m = odeint_spec("velocity_verlet", "odeint velocity_verlet", false, 2, 1, 1);
+  MethodSpec m{.library = "odeint",
+               .name = "velocity_verlet",
+               .label = "odeint velocity_verlet",
+               .order = 2,
+               .forces_per_step = 1,
+               .forces_extra = 1};
   m.make = [ecc, periods](ForceCounter* c) -> Prepare {
     return [ecc, periods, c](double spp) -> Run {
       const long k = static_cast<long>(spp);
@@ -346,7 +342,11 @@ inline MethodSpec odeint_verlet(double ecc, long periods) {
 }
 
 inline MethodSpec odeint_rkf78(double ecc, long periods) {
-  MethodSpec m = odeint_spec("runge_kutta_fehlberg78", "odeint rkf78", false, 8, 13, 0);
+  MethodSpec m{.library = "odeint",
+               .name = "runge_kutta_fehlberg78",
+               .label = "odeint rkf78",
+               .order = 8,
+               .forces_per_step = 13};
   m.make = [ecc, periods](ForceCounter* c) -> Prepare {
     return [ecc, periods, c](double spp) -> Run {
       const long k = static_cast<long>(spp);
@@ -374,7 +374,8 @@ Run odeint_adaptive_run(MakeStepper make_stepper, ForceCounter* c, double ecc, l
 }
 
 inline MethodSpec odeint_dopri5(double ecc, long periods) {
-  MethodSpec m = odeint_spec("runge_kutta_dopri5", "odeint dopri5", true, 5, 0, 0);
+  MethodSpec m{
+      .library = "odeint", .name = "runge_kutta_dopri5", .label = "odeint dopri5", .adaptive = true, .order = 5};
   m.make = [ecc, periods](ForceCounter* c) -> Prepare {
     return [ecc, periods, c](double tol) -> Run {
       return odeint_adaptive_run([tol] { return oi::make_controlled(tol, tol, oi::runge_kutta_dopri5<Vec4>()); }, c,
@@ -385,7 +386,7 @@ inline MethodSpec odeint_dopri5(double ecc, long periods) {
 }
 
 inline MethodSpec odeint_bs(double ecc, long periods) {
-  MethodSpec m = odeint_spec("bulirsch_stoer", "odeint bulirsch_stoer", true, 0, 0, 0);
+  MethodSpec m{.library = "odeint", .name = "bulirsch_stoer", .label = "odeint bulirsch_stoer", .adaptive = true};
   m.make = [ecc, periods](ForceCounter* c) -> Prepare {
     return [ecc, periods, c](double tol) -> Run {
       return odeint_adaptive_run([tol] { return oi::bulirsch_stoer<Vec4>(tol, tol); }, c, ecc, periods);
@@ -405,9 +406,9 @@ inline std::vector<MethodSpec> peer_methods(double ecc, long periods) {
   m.push_back(nystrom_adaptive("DP12-adaptive", ecc, periods));
   for (const char* name : {"M10-adaptive", "M12-adaptive", "M14-adaptive", "M16-adaptive"})
     m.push_back(nystrom_adaptive_mpe(name, ecc, periods));
-  m.push_back(nystrom_adaptive_mpe("M12-adaptive", ecc, periods, false));
+  m.push_back(nystrom_adaptive_mpe("M12-adaptive", ecc, periods, Compensation::off));
   m.push_back(nystrom_gbs(ecc, periods));
-  for (const char* name : {"M8", "SS10", "DP12"}) m.push_back(nystrom_fixed(name, ecc, periods, false));
+  for (const char* name : {"M8", "SS10", "DP12"}) m.push_back(nystrom_fixed(name, ecc, periods, Compensation::off));
   m.push_back(odeint_verlet(ecc, periods));
   m.push_back(odeint_symplectic<oi::symplectic_rkn_sb3a_mclachlan<Vec2>>("symplectic_rkn_sb3a_mclachlan",
                                                                          "odeint sb3a_mclachlan", 4, 6, ecc, periods));

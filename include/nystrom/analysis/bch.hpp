@@ -149,8 +149,10 @@ struct MethodAnalysis {
 
 namespace detail {
 
-inline double default_tolerance(bool exact, unsigned bits, int published_digits) {
-  if (exact) return 0;
+/// The magnitude up to which an error coefficient of a method with decimal coefficients counts as zero:
+/// 10^-(d - 4), d the decimal digits the coefficients are accurate to (the working precision or the published
+/// digits, whichever is less).
+inline double default_tolerance(unsigned bits, int published_digits) {
   const int prec_digits = static_cast<int>(bits * 30103u / 100000u);
   const int digits = published_digits > 0 ? std::min(published_digits, prec_digits) : prec_digits;
   return std::pow(10.0, -(digits - 4));
@@ -224,7 +226,7 @@ inline MethodAnalysis analyze_scheme(const SplittingScheme<bigcomplex>& scheme, 
     std::vector<std::pair<int, bigcomplex>> f;
     for (const auto& [letter, c] : operator_factors(scheme))
       f.emplace_back(letter, bigcomplex(bigfloat(c.re), bigfloat(c.im)));
-    const double tol = opt.tolerance > 0 ? opt.tolerance : detail::default_tolerance(false, bits, published_digits);
+    const double tol = opt.tolerance > 0 ? opt.tolerance : detail::default_tolerance(bits, published_digits);
     a = detail::fill_analysis(error_terms(bch_coordinates(f, s), s), s, tol);
   }
   a.precision_bits = a.exact ? 0 : bits;

@@ -447,9 +447,16 @@ struct DiscoverReport {
   long converged = 0;     // starts that converged in double precision
   long not_polished = 0;  // classes dropped: singular Jacobian (pivot ratio > 1e11) or no MPFR Newton convergence
   std::vector<DiscoveredMethod> methods;  // sorted: REAL, IMAGINARY, OTHER; then by error norm
-  long count(MethodClass c, bool positive_only = false) const {
+  /// Methods of class c.
+  long count(MethodClass c) const {
     long n = 0;
-    for (const auto& m : methods) n += m.cls == c && (!positive_only || m.positive);
+    for (const auto& m : methods) n += m.cls == c;
+    return n;
+  }
+  /// Methods of class c whose coefficients all have positive real parts.
+  long count_positive(MethodClass c) const {
+    long n = 0;
+    for (const auto& m : methods) n += m.cls == c && m.positive;
     return n;
   }
 };

@@ -48,20 +48,29 @@ inline unsigned reference_bits(long working_bits) {
   return static_cast<unsigned>(std::max<long>(256, working_bits + 64));
 }
 
+/// The lock held by every scope that sets Boost's process-wide MPFR default precision: BigPrecision (the
+/// reference precision of coefficients) and MpfrPrecision (core/extended.hpp, the working precision of
+/// mpfr_real). Recursive, so that the scopes nest in one thread; one mutex per process (a function-local
+/// static of an inline function is shared by all translation units).
+inline std::recursive_mutex& mpfr_default_precision_mutex() {
+  static std::recursive_mutex m;
+  return m;
+}
+
 /// Sets the MPFR default precision of bigfloat (in bits) for the lifetime of the guard.
 ///
 /// Boost 1.74 keeps that precision in one process-wide variable (a function-local static of
 /// mpfr_float_backend<0>, atomic but not thread_local), and every bigfloat created or computed reads it.
 /// Two threads building coefficients at different precisions would race on it (a race of logic, not a data
 /// race, so ThreadSanitizer is silent about it): one thread's coefficients could be rounded at the other's
-/// precision, and interleaved save/restore pairs could leave the wrong default behind. The guard therefore also holds a
-/// process-wide recursive mutex for its lifetime: a guard in another thread waits until this one ends, and guards
-/// nested in one thread nest as before. Coefficients are built once per integrator, outside the hot loop, so
-/// serialising their construction costs no speed where it matters. In a multi-threaded program, compute with bigfloat
-/// only inside a guard.
+/// precision, and interleaved save/restore pairs could leave the wrong default behind. The guard therefore also holds
+/// mpfr_default_precision_mutex() for its lifetime: a guard (or an MpfrPrecision scope) in another thread waits until
+/// this one ends, and guards nested in one thread nest. Coefficients are built once per integrator, outside the hot
+/// loop, so serialising their construction costs no speed where it matters. In a multi-threaded program, compute with
+/// bigfloat only inside a guard.
 class BigPrecision {
  public:
-  explicit BigPrecision(unsigned bits) : lock_(mutex()), saved_(bigfloat::default_precision()) {
+  explicit BigPrecision(unsigned bits) : lock_(mpfr_default_precision_mutex()), saved_(bigfloat::default_precision()) {
     bigfloat::default_precision(bits_to_digits10(bits));
   }
   ~BigPrecision() { bigfloat::default_precision(saved_); }  // lock_ is released after the restore
@@ -70,11 +79,6 @@ class BigPrecision {
   static unsigned bits_to_digits10(unsigned bits) { return bits * 30103u / 100000u + 2u; }
 
  private:
-  // One mutex per process: a function-local static of an inline function is shared by all translation units.
-  static std::recursive_mutex& mutex() {
-    static std::recursive_mutex m;
-    return m;
-  }
   std::unique_lock<std::recursive_mutex> lock_;  // declared first: taken before saved_ is read
   unsigned saved_;
 };

@@ -34,7 +34,7 @@ class too_many_steps : public error {
   using error::error;
 };
 
-/// The earlier names of the two integration failures.
+/// CamelCase names of the two integration failures (the same types).
 using StepSizeUnderflow = step_size_underflow;
 using TooManySteps = too_many_steps;
 

@@ -27,7 +27,11 @@
 //     (the catalog builds coefficients under a wider BigPrecision);
 //   * "mpfr:BITS" asks for at least BITS bits; the effective precision is the smallest one Boost
 //     can represent from a digits10 setting (e.g. 257 for 256), reported by scalar_traits::bits().
-// Not thread-safe, like Boost's default precision itself: one working precision per process at a time.
+// Boost's default precision is one variable per process, so an MpfrPrecision scope holds the same lock as
+// BigPrecision (mpfr_default_precision_mutex, core/bignum.hpp) for its lifetime: there is one MPFR working
+// precision per process at a time, and a thread that opens a scope (or builds coefficients) while another
+// thread's scope is open waits until that scope ends. Scopes and BigPrecision guards nest in one thread. In a
+// multi-threaded program, compute with mpfr_real only inside a scope.
 #pragma once
 
 #include <algorithm>
@@ -35,6 +39,7 @@
 #include <complex>
 #include <concepts>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -402,14 +407,16 @@ inline quad_double inv_r3(const quad_double& r2) {
 
 // ---- run-time MPFR precision ------------------------------------------------------------------
 
-/// The working precision of mpfr_real for the lifetime of the scope (see the top of this file).
+/// The working precision of mpfr_real for the lifetime of the scope (see the top of this file). Holds
+/// mpfr_default_precision_mutex() meanwhile: a scope in another thread waits until this one ends.
 class MpfrPrecision {
  public:
   static constexpr long min_bits = 53;     // below double precision there is nothing to gain
   static constexpr long max_bits = 65536;  // about 19 700 digits; keeps the catalog build bounded
 
   /// Throws std::invalid_argument unless min_bits <= bits <= max_bits.
-  explicit MpfrPrecision(long bits) : saved_(state()), saved_default_(mpfr_real::default_precision()) {
+  explicit MpfrPrecision(long bits)
+      : lock_(mpfr_default_precision_mutex()), saved_(state()), saved_default_(mpfr_real::default_precision()) {
     if (bits < min_bits || bits > max_bits)
       throw std::invalid_argument("MPFR precision must be between " + std::to_string(min_bits) + " and " +
                                   std::to_string(max_bits) + " bits, got " + std::to_string(bits));
@@ -417,7 +424,7 @@ class MpfrPrecision {
     state() = {bits, static_cast<long>(boost::multiprecision::detail::digits10_2_2(d10)), d10};
     mpfr_real::default_precision(d10);
   }
-  ~MpfrPrecision() {
+  ~MpfrPrecision() {  // lock_ is released after the restore
     state() = saved_;
     mpfr_real::default_precision(saved_default_);
   }
@@ -451,6 +458,7 @@ class MpfrPrecision {
     static State s;
     return s;
   }
+  std::unique_lock<std::recursive_mutex> lock_;  // declared first: taken before saved_ is read
   State saved_;
   unsigned saved_default_;
 };

@@ -324,6 +324,7 @@ class SplittingStepper {
     evals_ += evals;
   }
 
+ private:
   /// Sub-steps one after the other: schemes whose steps do not merge, and complex schemes whose state is
   /// projected to real after every step (the arguments as for advance_scaled).
   template <bool Comp>

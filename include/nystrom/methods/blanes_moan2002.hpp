@@ -30,8 +30,8 @@ inline SplittingScheme<bigcomplex> blanes_moan_srkn6b() {
   const auto b = bigs({"0.0829844064174052", "0.396309801498368", "-0.0390563049223486"});
   const bigcomplex a3 = big("1/2") - a[0].re - a[1].re;
   const bigcomplex b4 = 1 - 2 * (b[0].re + b[1].re + b[2].re);
-  const auto kicks = palindrome({b[0], b[1], b[2], b4}, true);
-  const auto drifts = palindrome({a[0], a[1], a3}, false);
+  const auto kicks = palindrome({b[0], b[1], b[2], b4}, PalindromeLength::odd);
+  const auto drifts = palindrome({a[0], a[1], a3}, PalindromeLength::even);
   return alternating(Flow::kick, kicks, drifts);
 }
 
@@ -47,7 +47,7 @@ inline SplittingScheme<bigcomplex> blanes_moan_srkn14a() {
   std::vector<bigcomplex> ha = a, hb = b;
   ha.push_back(bigcomplex(1 - 2 * sa));       // a8, the central drift
   hb.push_back(bigcomplex(big("1/2") - sb));  // b7 (twice, around the central drift)
-  return alternating(Flow::drift, palindrome(ha, true), palindrome(hb, false));
+  return alternating(Flow::drift, palindrome(ha, PalindromeLength::odd), palindrome(hb, PalindromeLength::even));
 }
 
 inline std::vector<MethodDef> blanes_moan2002() {

@@ -199,7 +199,7 @@ inline std::vector<CompositionTable> composition_tables() {
 inline std::vector<bigcomplex> table_weights(const CompositionTable& t) {
   std::vector<bigcomplex> half;
   for (const auto& x : t.half) half.push_back(big(x));
-  return palindrome(half, true);
+  return palindrome(half, PalindromeLength::odd);
 }
 
 /// The named compositions: Y4 (triple jump of order 4), Y6, KL6, KL8, SS10, each on PV (default) and

@@ -77,11 +77,14 @@ inline SplittingScheme<bigcomplex> compose(const SplittingScheme<bigcomplex>& ba
   return normalized(out);
 }
 
-/// Symmetric weights from the first half: w_1..w_m given, full sequence w_1..w_m..w_1 (odd length
-/// if `middle` is true: the last given weight is the central one).
-inline std::vector<bigcomplex> palindrome(const std::vector<bigcomplex>& half, bool middle) {
+/// The length of a palindrome completed from its first half w_1..w_m: odd, w_1..w_{m-1} w_m w_{m-1}..w_1 (the
+/// last given weight is the central one), or even, w_1..w_m w_m..w_1.
+enum class PalindromeLength : unsigned char { odd, even };
+
+/// Symmetric weights from the first half w_1..w_m (see PalindromeLength).
+inline std::vector<bigcomplex> palindrome(const std::vector<bigcomplex>& half, PalindromeLength length) {
   std::vector<bigcomplex> w = half;
-  for (std::size_t i = half.size() - (middle ? 1 : 0); i-- > 0;) w.push_back(half[i]);
+  for (std::size_t i = half.size() - (length == PalindromeLength::odd ? 1 : 0); i-- > 0;) w.push_back(half[i]);
   return w;
 }
 

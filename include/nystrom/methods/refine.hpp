@@ -468,13 +468,15 @@ inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published,
   out.composition = p.composition;
   std::vector<bigfloat> x = p.start, f;
   std::vector<std::vector<bigfloat>> jac;
-  auto evaluate = [&](const std::vector<bigfloat>& at, bool with_jacobian) {
+  enum class Jacobian : bool { skip, compute };
+  auto evaluate = [&](const std::vector<bigfloat>& at, Jacobian jacobian) {
+    std::vector<std::vector<bigfloat>>* const j = jacobian == Jacobian::compute ? &jac : nullptr;
     if (p.complex)
-      residual_rows<bigcomplex>(p, at, order, f, with_jacobian ? &jac : nullptr);
+      residual_rows<bigcomplex>(p, at, order, f, j);
     else
-      residual_rows<bigfloat>(p, at, order, f, with_jacobian ? &jac : nullptr);
+      residual_rows<bigfloat>(p, at, order, f, j);
   };
-  evaluate(x, true);
+  evaluate(x, Jacobian::compute);
   out.equations = f.size();
   out.published_residual = max_abs(f);
   if (!(out.published_residual < bigfloat("1e-8")))
@@ -535,7 +537,7 @@ inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published,
     bigfloat size(1);
     for (const auto& v : x) size = std::max(size, bigfloat(boost::multiprecision::abs(v)));
     const bool tiny_step = max_abs(dx) <= ldexp(size, static_cast<int>(8 - prec));
-    evaluate(x, newton);
+    evaluate(x, newton ? Jacobian::compute : Jacobian::skip);
     const bigfloat now = selected_max();
     if (tiny_step || now == 0) break;                  // converged to rounding
     if (max_abs(f) <= target && !(now < last)) break;  // no further progress
@@ -551,7 +553,7 @@ inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published,
           2.0 * static_cast<double>(x.size() + 1) * std::ceil(std::log2(std::max(2.0, want / have)));
       if (!(per_step > 1) || newton_cost < chord_cost) {
         newton = true;
-        evaluate(x, true);
+        evaluate(x, Jacobian::compute);
       }
     }
     last = now;
