@@ -212,8 +212,12 @@ double apsis_time_bound(const Solution<V2>& sol, const KeplerProblem<double>& kp
 }
 
 const std::vector<Event<V2>> apsides = {
-    {"pericentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, +1, false},
-    {"apocentre", [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; }, -1, false},
+    {.name = "pericentre",
+     .g = [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; },
+     .direction = +1},
+    {.name = "apocentre",
+     .g = [](double, const V2& q, const V2& v) { return q[0] * v[0] + q[1] * v[1]; },
+     .direction = -1},
 };
 
 }  // namespace
@@ -296,7 +300,8 @@ TEST(SolveEvents, HenonHeilesPoincareSectionLiesOnTheSectionAndTheEnergySurface)
   const double E = 0.125, y0 = 0.1, py0 = 0.2;
   const double px0 = std::sqrt(2 * E - py0 * py0 - y0 * y0 + 2 * y0 * y0 * y0 / 3);
   const SecondOrderProblem prob(f, Vd{0.0, y0}, Vd{px0, py0}, 0.0, 200.0);
-  const std::vector<Event<Vd>> ev = {{"x=0", [](double, const Vd& q, const Vd&) { return q[0]; }, +1, false}};
+  const std::vector<Event<Vd>> ev = {
+      {.name = "x=0", .g = [](double, const Vd& q, const Vd&) { return q[0]; }, .direction = +1}};
   const double eps = std::numeric_limits<double>::epsilon();
   // M8 at h = 0.1 and h = 0.2: energy errors of about 5e-13 and 1e-10 at the step ends, well above
   // rounding. A section point is a state of the dense output, so its energy error is bounded by the
