@@ -27,14 +27,16 @@ cmake --build "$build" -j "$jobs" --target "${targets[@]}"
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 status=0
+# Absolute paths: a harness may change its working folder (fuzz_cli runs in a private temporary one).
+root=$PWD
 for h in $harnesses; do
-  corpus="$build/corpus/$h"
+  corpus="$root/$build/corpus/$h"
   mkdir -p "$corpus" "$build/findings/$h"
   log="$build/fuzz_$h.log"
   echo "== fuzz_$h for ${seconds} s"
   # -timeout: one input running longer than 10 s is a finding (a hang); -rss_limit_mb: so is 2 GB of memory.
-  if "$build/fuzz/fuzz_$h" "$corpus" "fuzz/corpus/$h" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-      -max_len=4096 -print_final_stats=1 -artifact_prefix="$build/findings/$h/" >"$log" 2>&1; then
+  if "$build/fuzz/fuzz_$h" "$corpus" "$root/fuzz/corpus/$h" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      -max_len=4096 -print_final_stats=1 -artifact_prefix="$root/$build/findings/$h/" >"$log" 2>&1; then
     # libFuzzer's last status line: "#N DONE cov: C ft: F corp: ... exec/s: E"
     grep -E '^#[0-9]+.*(DONE|pulse)' "$log" | tail -1 | sed 's/^/   /'
     grep -E '^stat::number_of_executed_units|^stat::average_exec_per_sec' "$log" | sed 's/^/   /'

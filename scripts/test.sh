@@ -29,7 +29,7 @@ ctest --preset asan -j "$jobs"
 echo "   ($(( $(date +%s) - start )) s so far)"
 
 echo "== libFuzzer harnesses (clang-14, ASan + UBSan), ${NYSTROM_FUZZ_SECONDS:-20} s each"
-NYSTROM_FUZZ_SECONDS=${NYSTROM_FUZZ_SECONDS:-20} NYSTROM_FUZZ_HARNESSES="method_spec method_file particles" \
+NYSTROM_FUZZ_SECONDS=${NYSTROM_FUZZ_SECONDS:-20} NYSTROM_FUZZ_HARNESSES="method_spec method_file particles cli" \
   bash scripts/fuzz.sh
 
 echo "== all tests passed in $(( $(date +%s) - start )) s"
