@@ -152,7 +152,9 @@ TEST(LieAlgebra, GurkanMultiplicationTableHoldsInTheRknQuotient) {
                                {4, 5, {{11, 1}}}};
   const auto& s = lie_structure(6, BasisKind::hall, AlgebraKind::rkn);
   auto el = [&](int k) -> const LieElement& {
-    return s.elements()[static_cast<std::size_t>(s.find("X" + std::to_string(k)))];
+    std::string name = "X";
+    name += std::to_string(k);
+    return s.elements()[static_cast<std::size_t>(s.find(name))];
   };
   std::map<std::pair<int, int>, const Row*> listed;
   for (const auto& r : table) listed[{r.i, r.j}] = &r;
