@@ -42,9 +42,10 @@ inline std::filesystem::path temp_dir() {
   return d;
 }
 
-/// Runs `nystrom ARGS` (the arguments are the test's own, passed through the shell as written).
-inline Result run(const std::string& args) {
-  const auto dir = temp_dir();
+/// Runs `nystrom ARGS` (the arguments are the test's own, passed through the shell as written); its stdout and
+/// stderr go to files in DIR (created if needed).
+inline Result run(const std::string& args, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
   const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
   const std::string cmd = tool() + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
   const int status = std::system(cmd.c_str());
@@ -54,5 +55,8 @@ inline Result run(const std::string& args) {
   r.err = slurp(err);
   return r;
 }
+
+/// Runs `nystrom ARGS` with its output files in the running test's own folder (temp_dir()).
+inline Result run(const std::string& args) { return run(args, temp_dir()); }
 
 }  // namespace cli_test

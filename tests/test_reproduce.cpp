@@ -11,7 +11,6 @@
 // the tool fails), and the orders of Fig. 5.1 are measured against theory.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -27,38 +26,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string tool() {
-  const char* b = std::getenv("NYSTROM_BIN");
-  return b ? b : "nystrom";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-Result run(const std::string& args, const fs::path& dir) {
-  fs::create_directories(dir);
-  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = tool() + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using cli_test::run;
+using cli_test::slurp;
 
 /// A CSV file as rows of column name -> text.
 std::vector<std::map<std::string, std::string>> read_csv(const fs::path& p) {
