@@ -2,24 +2,28 @@
 # Builds the libFuzzer harnesses of fuzz/ with clang-14 (ASan + UBSan) and runs each for a fixed time,
 # starting from the seed corpus in fuzz/corpus/<harness>/. Fails on any crash, leak, UB report, timeout or
 # out-of-memory. Environment: NYSTROM_FUZZ_SECONDS (per harness, default 30), NYSTROM_FUZZ_HARNESSES (default
-# all four), NYSTROM_FUZZ_JOBS (build jobs, default nproc). New inputs found go to build/fuzz/corpus/<harness>/,
+# all four), NYSTROM_FUZZ_JOBS (build jobs, default nproc), NYSTROM_FUZZ_BUILD (a build folder configured with
+# NYSTROM_BUILD_FUZZERS=ON, e.g. by the asan-fuzz preset, to build and run the harnesses there; default: build/fuzz,
+# configured here). New inputs found go to build/fuzz/corpus/<harness>/,
 # never into the repository's seed corpus. docs/fuzzing.md: how to run longer and how to keep a finding.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${NYSTROM_FUZZ_SECONDS:-30}
 harnesses=${NYSTROM_FUZZ_HARNESSES:-"method_spec method_file particles cli"}
 jobs=${NYSTROM_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}
-build=build/fuzz
+build=${NYSTROM_FUZZ_BUILD:-build/fuzz}
 san="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 
-# Ninja and ccache when present (a folder configured before keeps its generator).
-extra=()
-if [ ! -f "$build/CMakeCache.txt" ] && command -v ninja >/dev/null; then extra+=(-G Ninja); fi
-if command -v ccache >/dev/null; then extra+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
-CXX=clang++-14 cmake -S . -B "$build" "${extra[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS="$san -Werror" -DNYSTROM_BUILD_FUZZERS=ON \
-  -DNYSTROM_BUILD_TOOL=OFF -DNYSTROM_BUILD_TESTS=OFF -DNYSTROM_BUILD_BENCH=OFF -DNYSTROM_BUILD_EXAMPLES=OFF \
-  -DNYSTROM_PCH=OFF >/dev/null
+if [ -z "${NYSTROM_FUZZ_BUILD:-}" ]; then
+  # Ninja and ccache when present (a folder configured before keeps its generator).
+  extra=()
+  if [ ! -f "$build/CMakeCache.txt" ] && command -v ninja >/dev/null; then extra+=(-G Ninja); fi
+  if command -v ccache >/dev/null; then extra+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+  CXX=clang++-14 cmake -S . -B "$build" "${extra[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS="$san -Werror" -DNYSTROM_BUILD_FUZZERS=ON \
+    -DNYSTROM_BUILD_TOOL=ON -DNYSTROM_BUILD_TESTS=OFF -DNYSTROM_BUILD_BENCH=OFF -DNYSTROM_BUILD_EXAMPLES=OFF \
+    -DNYSTROM_PCH=OFF >/dev/null
+fi
 targets=()
 for h in $harnesses; do targets+=("fuzz_$h"); done
 cmake --build "$build" -j "$jobs" --target "${targets[@]}"

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Command 2 of the README (and what CI runs): install the dependencies; check the formatting; build the tool,
 # benchmarks, examples and Python module in Release with warnings as errors and run the tests that need the
-# optimised build there (the tool's tests, the Python tests, the install check); build the tool and every C++
-# test under AddressSanitizer + UBSan (leak detection on) and run the whole C++ suite there, the library's tests
-# included (each test program is built once for them); build the libFuzzer harnesses and run each for a fixed time.
+# optimised build there (the tool's tests, the Python tests, the install check); build the tool, every C++ test
+# and the libFuzzer harnesses with clang-14 under AddressSanitizer + UBSan (leak detection on), run the whole C++
+# suite there (the library's test programs are built only there) and each harness for a fixed time.
 # NYSTROM_FUZZ_SECONDS: seconds per fuzzer (default 20).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,15 +22,16 @@ cmake --build --preset release -j "$jobs"
 ctest --preset release -j "$jobs"
 echo "   ($(( $(date +%s) - start )) s so far)"
 
-echo "== AddressSanitizer + UndefinedBehaviorSanitizer build: the tool and the whole C++ suite"
-cmake --preset asan -DCMAKE_CXX_FLAGS="-Werror" -DNYSTROM_BUILD_TOOL=ON -DNYSTROM_TEST_SCOPE=all >/dev/null
-cmake --build --preset asan -j "$jobs"
+echo "== AddressSanitizer + UndefinedBehaviorSanitizer build (clang-14): the tool, the whole C++ suite, the fuzzers"
+# One compilation serves the tests and the libFuzzer harnesses (fuzz_cli links the tool's own objects).
+cmake --preset asan-fuzz -DCMAKE_CXX_FLAGS="-Werror" >/dev/null
+cmake --build --preset asan-fuzz -j "$jobs"
 # test_bench_peers asserts the convergence of timed benchmark runs: it runs in Release only.
-ctest --preset asan -j "$jobs" -E '^test_bench_peers$'
+ctest --preset asan-fuzz -j "$jobs" -E '^test_bench_peers$'
 echo "   ($(( $(date +%s) - start )) s so far)"
 
-echo "== libFuzzer harnesses (clang-14, ASan + UBSan), ${NYSTROM_FUZZ_SECONDS:-20} s each"
-NYSTROM_FUZZ_SECONDS=${NYSTROM_FUZZ_SECONDS:-20} NYSTROM_FUZZ_HARNESSES="method_spec method_file particles cli" \
-  bash scripts/fuzz.sh
+echo "== libFuzzer harnesses (ASan + UBSan), ${NYSTROM_FUZZ_SECONDS:-20} s each"
+NYSTROM_FUZZ_BUILD=build/asan-fuzz NYSTROM_FUZZ_SECONDS=${NYSTROM_FUZZ_SECONDS:-20} \
+  NYSTROM_FUZZ_HARNESSES="method_spec method_file particles cli" bash scripts/fuzz.sh
 
 echo "== all tests passed in $(( $(date +%s) - start )) s"

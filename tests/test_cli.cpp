@@ -138,7 +138,8 @@ TEST(Cli, NBodyTwoBodyAndGbsRuns) {
     EXPECT_EQ(r.code, 0) << r.err;
     return nlohmann::json::parse(r.out)["position_error"].get<double>();
   };
-  for (const auto& [method, order] : std::vector<std::pair<std::string, double>>{{"Y4", 4}, {"BR1", 6}}) {
+  for (const auto& [name, order] : std::vector<std::pair<std::string, double>>{{"Y4", 4}, {"BR1", 6}}) {
+    const std::string method = name;  // a lambda may not capture a structured binding (clang 14)
     std::string log;
     const auto s = slopes_of(
         {50, 100, 200, 400}, [&](int n) { return err(method, n); }, log);
