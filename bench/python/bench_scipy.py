@@ -98,6 +98,15 @@ def main():
     mod, res = timed(lambda: nystrom.solve(prob, t_span=(0, T1), method="M8", steps=spp * PERIODS, t_eval=[T1]), 5)
     overhead = mod / lib
 
+    # Cost of one Python force call through nystrom.solve against a bare loop calling the same force.
+    n_calls = 20000
+    q_probe = np.array(prob.q0)
+    bare, _ = timed(lambda: [accel(0.0, q_probe) for _ in range(n_calls)], max(repeat, 3))
+    through, res = timed(lambda: nystrom.solve(accel, prob.q0, prob.v0, t_span=(0, T1), method="M8",
+                                               steps=n_calls // 10, t_eval=[T1]), max(repeat, 3))
+    per_call_bare = bare / n_calls
+    per_call = through / res.force_evals
+
     print("\ncheapest run reaching each error (wall time; ratio = DOP853 time / this time):")
     summary = {}
     for target in TARGETS:
@@ -119,10 +128,12 @@ def main():
             print("    scipy DOP853 does not reach it")
     print(f"\nmodule overhead on the built-in force (M8, {spp} steps/period, {PERIODS} periods): "
           f"nystrom.solve {mod:.4f} s / library loop {lib:.4f} s = {overhead:.3f}x")
+    print(f"a Python force call through nystrom.solve (M8, fixed steps): {1e6 * per_call:.2f} us, the bare call "
+          f"{1e6 * per_call_bare:.2f} us")
     if args.json:
         with open(args.json, "w") as f:
-            json.dump(dict(runs=runs, summary=summary, overhead=overhead, library_seconds=lib, module_seconds=mod),
-                      f, indent=1)
+            json.dump(dict(runs=runs, summary=summary, overhead=overhead, library_seconds=lib, module_seconds=mod,
+                           python_call_seconds=per_call, bare_call_seconds=per_call_bare), f, indent=1)
     return 0
 
 
