@@ -27,7 +27,7 @@ class OdeResult(dict):
     -1: failure, no states returned), ``message``, ``success``, ``sol`` (a :class:`DenseSolution` when
     ``dense_output=True``), ``t_events``, ``q_events``, ``v_events`` (one array per event function),
     ``method``, ``precision``, ``h`` (fixed steps: the step size), ``q_str``/``v_str`` (the final state in
-    full working precision, as decimal strings).
+    full working precision, as decimal strings), ``solve_seconds`` (wall time of the library's solve() call).
     """
 
     def __getattr__(self, name):
@@ -332,6 +332,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.method = info["name"]
     res.precision = precision
     res.h = None if not fixed else (h_value if h_value > 0 else abs(t1 - t0) / n_steps)
+    res.solve_seconds = float(d["solve_seconds"])
     res.q_str = list(d["q_str"])
     res.v_str = list(d["v_str"])
     return res

@@ -12,6 +12,7 @@
 #include <pybind11/pybind11.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <cstddef>
@@ -214,6 +215,7 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   Solution<V> sol;
   int status = 0;
   std::string message;
+  const auto start = std::chrono::steady_clock::now();
   try {
     if (release) {
       py::gil_scoped_release free;
@@ -234,7 +236,9 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
     message = e.what();
   }
 
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   py::dict d;
+  d["solve_seconds"] = seconds;
   std::vector<double> t, q, v;
   for (const auto& x : sol.t) t.push_back(as_double(x));
   for (const auto& x : sol.q) append_doubles(x, n, q);
