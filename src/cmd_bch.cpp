@@ -13,6 +13,7 @@
 
 #include "cli.hpp"
 #include "nystrom/analysis/bch.hpp"
+#include "nystrom/analysis/bch_report.hpp"
 #include "nystrom/analysis/method_file.hpp"
 #include "nystrom/methods/catalog.hpp"
 
@@ -45,13 +46,6 @@ std::string show_term(const an::ErrorTerm& t, double tol) {
   if (std::abs(z.imag()) <= tol) z.imag(0);
   if (z == std::complex<double>(0, 0)) return fmt::format("0 (|.| = {:.1e})", std::abs(t.value));
   return show(z);
-}
-
-nlohmann::json term_json(const an::ErrorTerm& t) {
-  nlohmann::json j{{"name", t.name},       {"definition", t.definition}, {"bracket", t.bracket},
-                   {"re", t.value.real()}, {"im", t.value.imag()},       {"abs", std::abs(t.value)}};
-  if (!t.exact.empty()) j["exact"] = t.exact;
-  return j;
 }
 
 int print_table() {
@@ -97,32 +91,7 @@ int run(const Options& o) {
   const an::MethodAnalysis a = an::analyze_method(def, opt);
   const std::string order_text = a.order_is_lower_bound ? ">= " + std::to_string(a.order) : std::to_string(a.order);
   if (o.json) {
-    nlohmann::json j;
-    j["method"] = a.method;
-    j["degree"] = a.degree;
-    j["basis"] = an::to_string(a.basis);
-    j["algebra"] = an::to_string(a.algebra);
-    j["exact"] = a.exact;
-    j["precision_bits"] = a.precision_bits;
-    j["tolerance"] = a.tolerance;
-    j["declared_order"] = a.declared_order;
-    j["order"] = a.order;
-    j["order_is_lower_bound"] = a.order_is_lower_bound;
-    j["order_confirmed"] = a.declared_order_confirmed();
-    nlohmann::json degs = nlohmann::json::array();
-    for (const auto& d : a.degrees) {
-      nlohmann::json terms = nlohmann::json::array();
-      for (const auto& t : d.terms) terms.push_back(term_json(t));
-      degs.push_back({{"degree", d.degree}, {"vanishes", d.vanishes}, {"norm", d.norm}, {"terms", terms}});
-    }
-    j["degrees"] = degs;
-    if (const auto* l = a.leading()) {
-      nlohmann::json terms = nlohmann::json::array();
-      for (const auto& t : l->terms) terms.push_back(term_json(t));
-      j["leading"] = {{"degree", l->degree}, {"norm", l->norm}, {"terms", terms}};
-    } else {
-      j["leading"] = nullptr;
-    }
+    const auto j = an::bch_report_json<nlohmann::json>(a);
     std::cout << j.dump(2) << "\n";
     return 0;
   }

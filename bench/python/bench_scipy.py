@@ -5,7 +5,7 @@ integrator a sweep of tolerances; the cheapest run (wall time) reaching 1e-6 and
 ratios to DOP853. scipy integrates the first-order system y = (q, v), f = (v, a(q)); nystrom integrates
 q'' = a(q) with the same Python force a(q), and with the built-in (C++) force. The module's overhead is the
 time of nystrom.solve on the built-in force against the C++ library's own fixed-step loop
-(experiments/kepler.hpp) on the same steps.
+(experiments/kepler.hpp) on the same steps, and against the library's solve() call inside it (res.solve_seconds).
 
     PYTHONPATH=<build>/python python3 bench/python/bench_scipy.py [--quick] [--json FILE]
 """
@@ -97,6 +97,18 @@ def main():
     lib = min(_core.library_kepler_seconds("M8", E, spp, PERIODS)[0] for _ in range(5))
     mod, res = timed(lambda: nystrom.solve(prob, t_span=(0, T1), method="M8", steps=spp * PERIODS, t_eval=[T1]), 5)
     overhead = mod / lib
+    # ... and against the library's solve() inside that call (the driver's own per-step cost excluded).
+    in_solve = min(nystrom.solve(prob, t_span=(0, T1), method="M8", steps=spp * PERIODS,
+                                 t_eval=[T1]).solve_seconds for _ in range(5))
+
+    # Cost of one Python force call through nystrom.solve against a bare loop calling the same force.
+    n_calls = 20000
+    q_probe = np.array(prob.q0)
+    bare, _ = timed(lambda: [accel(0.0, q_probe) for _ in range(n_calls)], max(repeat, 3))
+    through, res = timed(lambda: nystrom.solve(accel, prob.q0, prob.v0, t_span=(0, T1), method="M8",
+                                               steps=n_calls // 10, t_eval=[T1]), max(repeat, 3))
+    per_call_bare = bare / n_calls
+    per_call = through / res.force_evals
 
     print("\ncheapest run reaching each error (wall time; ratio = DOP853 time / this time):")
     summary = {}
@@ -118,11 +130,15 @@ def main():
         if ref is None:
             print("    scipy DOP853 does not reach it")
     print(f"\nmodule overhead on the built-in force (M8, {spp} steps/period, {PERIODS} periods): "
-          f"nystrom.solve {mod:.4f} s / library loop {lib:.4f} s = {overhead:.3f}x")
+          f"nystrom.solve {mod:.4f} s / library loop {lib:.4f} s = {overhead:.3f}x; / the C++ solve() it calls "
+          f"{in_solve:.4f} s = {mod / in_solve:.3f}x")
+    print(f"a Python force call through nystrom.solve (M8, fixed steps): {1e6 * per_call:.2f} us, the bare call "
+          f"{1e6 * per_call_bare:.2f} us")
     if args.json:
         with open(args.json, "w") as f:
-            json.dump(dict(runs=runs, summary=summary, overhead=overhead, library_seconds=lib, module_seconds=mod),
-                      f, indent=1)
+            json.dump(dict(runs=runs, summary=summary, overhead=overhead, library_seconds=lib, module_seconds=mod,
+                           solve_seconds=in_solve,
+                           python_call_seconds=per_call, bare_call_seconds=per_call_bare), f, indent=1)
     return 0
 
 

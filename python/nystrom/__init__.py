@@ -10,6 +10,8 @@ over a process pool, a Dask client or an MPI pool; ``nystrom.plot`` draws orbits
 work-precision charts.
 """
 
+import json
+
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
 from .ensemble import ensemble
@@ -67,11 +69,12 @@ def coeffs(what, seq=None, order=None, n=None, sum=None, digits=20):
 def bch(method, degree=7, basis="hall", algebra="rkn", bits=192, tolerance=0.0):
     """The BCH series of a splitting method, as ``nystrom bch --json``: the coefficients of H - Z (the
     method's modified Hamiltonian minus the exact one) in a Lie basis for every degree up to ``degree``,
-    the algebraic order and the leading error terms (Gürkan, sec. 4). basis: "hall" or "lyndon"; algebra:
+    the algebraic order and the leading error terms (Gürkan, sec. 4); every term with re, im, abs and, when
+    computed exactly, the rational ``exact``. basis: "hall" or "lyndon"; algebra:
     "rkn" (q'' = a(q): [V,[V,[T,V]]] = 0) or "free"."""
     if not isinstance(method, str):
         raise TypeError(f"method must be a string, got {type(method).__name__}")
-    return _core.bch(method, int(degree), str(basis), str(algebra), int(bits), float(tolerance))
+    return json.loads(_core.bch_json(method, int(degree), str(basis), str(algebra), int(bits), float(tolerance)))
 
 
 def __getattr__(name):

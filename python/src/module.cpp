@@ -1,6 +1,7 @@
-// nystrom._core: the compiled part of the Python package. The catalog (methods, coeffs) and the
-// steppers the pure-Python driver (nystrom/_solve.py) advances. Library errors (std::invalid_argument)
-// reach Python as ValueError with the library's one-line message.
+// nystrom._core: the compiled part of the Python package. The catalog (methods, coeffs, bch) and solve()
+// (nystrom/solve.hpp) on a Python force or a built-in problem (solve_binding.hpp); nystrom/_solve.py checks
+// the arguments and wraps the result. Library errors (std::invalid_argument, nystrom::invalid_input) reach
+// Python as ValueError with the library's one-line message.
 #include <pybind11/complex.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -8,17 +9,21 @@
 
 #include <cmath>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "nystrom/analysis/bch.hpp"
+#include "nystrom/analysis/bch_report.hpp"
 #include "nystrom/engines/mpe.hpp"
 #include "nystrom/experiments/kepler.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/plummer.hpp"
-#include "stepper.hpp"
+#include "solve_binding.hpp"
 
 namespace py = pybind11;
 using namespace nystrom;
@@ -121,106 +126,42 @@ py::dict method_coeffs(const std::string& spec, int digits) {
   return j;
 }
 
-/// The BCH analysis of a splitting method, as `nystrom bch --json` gives it.
-py::dict bch(const std::string& method, int degree, const std::string& basis, const std::string& algebra, unsigned bits,
-             double tolerance) {
+/// The BCH analysis of a splitting method as JSON text, the document `nystrom bch --json` prints.
+std::string bch_json(const std::string& method, int degree, const std::string& basis, const std::string& algebra,
+                     unsigned bits, double tolerance) {
   namespace an = nystrom::analysis;
   an::check_degree(degree);
   if (bits < 64 || bits > 4096) throw std::invalid_argument("bits must be between 64 and 4096");
-  if (!(tolerance >= 0)) throw std::invalid_argument("tolerance must be >= 0");
+  if (!(tolerance >= 0) || !std::isfinite(tolerance) || tolerance >= 1)
+    throw std::invalid_argument("tolerance must be >= 0 and below 1");
   an::AnalysisOptions opt;
   opt.degree = degree;
   opt.basis = an::parse_basis(basis);
   opt.algebra = an::parse_algebra(algebra);
   opt.precision_bits = bits;
   opt.tolerance = tolerance;
-  const an::MethodAnalysis a = an::analyze_method(resolve_method(method), opt);
-  auto terms = [](const an::DegreeTerms& d) {
-    py::list out;
-    for (const auto& t : d.terms) {
-      py::dict x;
-      x["name"] = t.name;
-      x["definition"] = t.definition;
-      x["bracket"] = t.bracket;
-      x["value"] = t.value;
-      x["exact"] = t.exact;
-      out.append(x);
-    }
-    return out;
-  };
-  py::dict j;
-  j["method"] = a.method;
-  j["degree"] = a.degree;
-  j["basis"] = an::to_string(a.basis);
-  j["algebra"] = an::to_string(a.algebra);
-  j["exact"] = a.exact;
-  j["precision_bits"] = a.precision_bits;
-  j["tolerance"] = a.tolerance;
-  j["declared_order"] = a.declared_order;
-  j["order"] = a.order;
-  j["order_is_lower_bound"] = a.order_is_lower_bound;
-  py::list degs;
-  for (const auto& d : a.degrees) {
-    py::dict x;
-    x["degree"] = d.degree;
-    x["vanishes"] = d.vanishes;
-    x["norm"] = d.norm;
-    x["terms"] = terms(d);
-    degs.append(x);
-  }
-  j["degrees"] = degs;
-  if (const auto* l = a.leading()) {
-    py::dict x;
-    x["degree"] = l->degree;
-    x["norm"] = l->norm;
-    x["terms"] = terms(*l);
-    j["leading"] = x;
-  } else {
-    j["leading"] = py::none();
-  }
-  return j;
+  return an::bch_report_json<nlohmann::json>(an::analyze_method(resolve_method(method), opt)).dump();
 }
 
-/// A stepper as Python sees it.
-struct PyStepper {
-  std::unique_ptr<Stepper> s;
-};
+/// The method solve() runs: resolve_solve_method(spec); with a tolerance, a multi-product method of
+/// fixed steps becomes its adaptive form (M<2n> -> M<2n>-adaptive, mpe:K -> mpe-pv-adaptive:K).
+MethodDef solve_method(const std::string& spec, bool tolerance) {
+  MethodDef def = resolve_solve_method(spec);
+  if (!tolerance || def.info.family != "mpe" || def.info.adaptive) return def;
+  const auto data = def.build();
+  const auto& m = std::get<MpeDef>(data);
+  const std::string& name = def.info.name;
+  const bool m_order =
+      name.size() > 1 && name[0] == 'M' && name.find_first_not_of("0123456789", 1) == std::string::npos;
+  if (m_order) return resolve_method(name + "-adaptive");
+  std::string seq;
+  for (long k : m.k) seq += (seq.empty() ? "" : ",") + std::to_string(k);
+  return resolve_method(std::string(m.base_name == "VV" ? "mpe-vv" : "mpe-pv") + "-adaptive:" + seq);
+}
 
 using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-const double* checked(const DArray& a, std::size_t n, const char* what) {
-  if (static_cast<std::size_t>(a.size()) != n)
-    throw std::invalid_argument(std::string(what) + " has " + std::to_string(a.size()) + " values, expected " +
-                                std::to_string(n));
-  return a.data();
-}
-
-py::dict status_dict(const AdvanceStatus& st, Record* rec, std::size_t n) {
-  py::dict d;
-  d["steps"] = st.steps;
-  d["rejected"] = st.rejected;
-  d["failed"] = st.failed;
-  d["message"] = st.message;
-  if (rec) {
-    const auto m = static_cast<py::ssize_t>(rec->t.size());
-    const auto dn = static_cast<py::ssize_t>(n);
-    d["t"] = py::array_t<double>(m, rec->t.data());
-    d["q"] = py::array_t<double>({m, dn}, rec->q.data());
-    d["v"] = py::array_t<double>({m, dn}, rec->v.data());
-  }
-  return d;
-}
-
-StepperOptions options(double tol, double h0, double h_max, long max_steps, bool keep_complex) {
-  if (!(tol >= 0) || !std::isfinite(tol)) throw std::invalid_argument("tolerance must be a positive finite number");
-  StepperOptions o;
-  o.tol = tol;
-  o.h0 = h0;
-  o.h_max = h_max;
-  o.max_steps = max_steps;
-  o.keep_complex = keep_complex;
-  return o;
-}
+std::vector<double> flat(const DArray& a) { return std::vector<double>(a.data(), a.data() + a.size()); }
 
 }  // namespace
 
@@ -242,9 +183,9 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "optimal_mpe_sequence", [](int n, long sum) { return optimal_mpe_sequence(n, sum); }, py::arg("n"),
       py::arg("sum"));
-  m.def("bch", &bch, py::arg("method"), py::arg("degree") = 7, py::arg("basis") = "hall", py::arg("algebra") = "rkn",
-        py::arg("bits") = 192u, py::arg("tolerance") = 0.0,
-        "BCH series of a splitting method: coefficients of H - Z per degree, order, leading error terms.");
+  m.def("bch_json", &bch_json, py::arg("method"), py::arg("degree") = 7, py::arg("basis") = "hall",
+        py::arg("algebra") = "rkn", py::arg("bits") = 192u, py::arg("tolerance") = 0.0,
+        "BCH series of a splitting method as the JSON text of `nystrom bch --json`.");
   m.def("method_coeffs", &method_coeffs, py::arg("spec"), py::arg("digits") = 20,
         "The coefficients of a catalog method, as decimal strings.");
 
@@ -277,93 +218,71 @@ PYBIND11_MODULE(_core, m) {
       "For benchmarks: the C++ library's own fixed-step Kepler run (experiments/kepler.hpp) without the Python "
       "driver: (seconds, force evaluations, final position error).");
 
-  py::class_<PyStepper>(m, "Stepper")
-      .def_property_readonly("dim", [](const PyStepper& p) { return p.s->dim(); })
-      .def_property_readonly("adaptive", [](const PyStepper& p) { return p.s->adaptive(); })
-      .def_property_readonly("python_force", [](const PyStepper& p) { return p.s->python_force(); })
-      .def_property_readonly("force_evals", [](const PyStepper& p) { return p.s->force_evals(); })
-      .def("set_state",
-           [](PyStepper& p, const DArray& q, const DArray& v) {
-             const std::size_t n = p.s->dim();
-             p.s->set_state(checked(q, n, "q0"), checked(v, n, "v0"));
-           })
-      .def("state",
-           [](const PyStepper& p) {
-             const auto n = static_cast<py::ssize_t>(p.s->dim());
-             py::array_t<double> q(n), v(n);
-             p.s->get_state(q.mutable_data(), v.mutable_data());
-             return py::make_tuple(q, v);
-           })
-      .def("state_strings", [](const PyStepper& p) { return p.s->state_strings(); })
-      .def("acceleration",
-           [](PyStepper& p, const DArray& q) {
-             const std::size_t n = p.s->dim();
-             py::array_t<double> a(static_cast<py::ssize_t>(n));
-             p.s->acceleration(checked(q, n, "q"), a.mutable_data());
-             return a;
-           })
-      .def(
-          "advance_fixed",
-          [](PyStepper& p, double t0, double t1, long n, long every, py::object progress) {
-            Record rec;
-            Record* r = every > 0 ? &rec : nullptr;
-            Heartbeat hb{std::move(progress), !p.s->python_force()};
-            AdvanceStatus st;
-            if (hb.release_gil) {
-              py::gil_scoped_release free;
-              st = p.s->advance_fixed(t0, t1, n, every, r, hb);
-            } else {
-              st = p.s->advance_fixed(t0, t1, n, every, r, hb);
-            }
-            return status_dict(st, r, p.s->dim());
-          },
-          py::arg("t0"), py::arg("t1"), py::arg("n"), py::arg("every") = 0, py::arg("progress") = py::none())
-      .def(
-          "advance_adaptive",
-          [](PyStepper& p, double t0, double t1, bool record, py::object progress) {
-            Record rec;
-            Record* r = record ? &rec : nullptr;
-            Heartbeat hb{std::move(progress), !p.s->python_force()};
-            AdvanceStatus st;
-            if (hb.release_gil) {
-              py::gil_scoped_release free;
-              st = p.s->advance_adaptive(t0, t1, r, hb);
-            } else {
-              st = p.s->advance_adaptive(t0, t1, r, hb);
-            }
-            return status_dict(st, r, p.s->dim());
-          },
-          py::arg("t0"), py::arg("t1"), py::arg("record") = false, py::arg("progress") = py::none());
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const nystrom::invalid_input& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
 
   m.def(
-      "builtin_stepper",
-      [](const std::string& problem, const std::vector<double>& params, std::size_t n, const std::string& method,
-         const std::string& precision, double tol, double h0, double h_max, long max_steps, bool keep_complex) {
-        const MethodDef def = resolve_method(method);
-        const StepperOptions o = options(tol, h0, h_max, max_steps, keep_complex);
-        PyStepper p;
-        if (precision == "double")
-          p.s = make_builtin_stepper_double(problem, params, n, def, o);
-        else
-          p.s = make_builtin_stepper_extended(problem, params, n, def, o, precision);
-        return p;
-      },
-      py::arg("problem"), py::arg("params"), py::arg("n"), py::arg("method"), py::arg("precision") = "double",
-      py::arg("tol") = 0.0, py::arg("h0") = 0.0, py::arg("h_max") = 0.0, py::arg("max_steps") = 10000000L,
-      py::arg("keep_complex") = false);
+      "solve_method_info",
+      [](const std::string& spec, bool tolerance) { return info_dict(solve_method(spec, tolerance).info); },
+      py::arg("spec"), py::arg("tolerance"),
+      "The catalog record of the method solve() runs for spec (with a tolerance: the adaptive form of a "
+      "multi-product method).");
+
+  py::class_<DenseSolution>(m, "DenseSolution")
+      .def_property_readonly("t_first", &DenseSolution::t_first)
+      .def_property_readonly("t_last", &DenseSolution::t_last)
+      .def("__call__", [](const DenseSolution& s, const DArray& ts) {
+        const auto k = static_cast<py::ssize_t>(ts.size());
+        const auto n = static_cast<py::ssize_t>(s.dim());
+        py::array_t<double> q({k, n}), v({k, n});
+        for (py::ssize_t i = 0; i < k; ++i) s.eval(ts.data()[i], q.mutable_data() + i * n, v.mutable_data() + i * n);
+        return py::make_tuple(q, v);
+      });
+
   m.def(
-      "python_stepper",
-      [](py::object fn, std::vector<py::ssize_t> shape, const std::string& method, double tol, double h0, double h_max,
-         long max_steps, bool keep_complex) {
-        const MethodDef def = resolve_method(method);
-        const StepperOptions o = options(tol, h0, h_max, max_steps, keep_complex);
-        std::size_t n = 1;
-        for (auto s : shape) n *= static_cast<std::size_t>(s);
-        PyStepper p;
-        std::shared_ptr<double> time_slot;  // the force's time, set by the stepper at every stage
-        p.s = make_python_stepper(std::move(fn), std::move(shape), n, def, o, time_slot);
-        return p;
+      "solve",
+      [](const std::string& problem, const std::vector<double>& params, py::object force,
+         std::vector<py::ssize_t> shape, const DArray& q0, const DArray& v0, double t0, double t1,
+         const std::string& method, const std::string& precision, double h, long steps, double rtol, double atol,
+         std::optional<std::vector<double>> t_eval, const py::list& events, bool dense, bool keep_complex,
+         long max_steps, py::object progress) {
+        SolveRequest r;
+        r.method = solve_method(method, rtol > 0 || atol > 0);
+        r.q0 = flat(q0);
+        r.v0 = flat(v0);
+        if (r.q0.size() != r.v0.size()) throw invalid_input("q0 and v0 differ in size");
+        r.t0 = t0;
+        r.t1 = t1;
+        r.options.h = h;
+        r.options.steps = steps;
+        r.options.rtol = rtol;
+        r.options.atol = atol;
+        if (t_eval) r.options.t_eval = *t_eval;
+        r.options.dense = dense;
+        r.options.max_steps = max_steps;
+        r.options.engine.keep_complex = keep_complex;
+        for (const auto& e : events) {
+          const auto t = e.cast<py::tuple>();
+          r.events.push_back({t[0], t[1].cast<int>(), t[2].cast<bool>(), t[3].cast<std::string>()});
+        }
+        r.progress = std::move(progress);
+        if (problem.empty()) {
+          if (precision != "double")
+            throw invalid_input("precision '" + precision + "' is available for built-in problems only");
+          return solve_python_force(std::move(force), std::move(shape), r);
+        }
+        if (precision == "double") return solve_builtin_double(problem, params, r);
+        return solve_builtin_extended(problem, params, r, precision);
       },
-      py::arg("force"), py::arg("shape"), py::arg("method"), py::arg("tol") = 0.0, py::arg("h0") = 0.0,
-      py::arg("h_max") = 0.0, py::arg("max_steps") = 10000000L, py::arg("keep_complex") = false);
+      py::arg("problem"), py::arg("params"), py::arg("force"), py::arg("shape"), py::arg("q0"), py::arg("v0"),
+      py::arg("t0"), py::arg("t1"), py::arg("method"), py::arg("precision"), py::arg("h"), py::arg("steps"),
+      py::arg("rtol"), py::arg("atol"), py::arg("t_eval"), py::arg("events"), py::arg("dense"), py::arg("keep_complex"),
+      py::arg("max_steps"), py::arg("progress"),
+      "solve() (nystrom/solve.hpp) on a built-in problem (problem: its name) or a Python force(t, q) "
+      "(problem: ''); nystrom.solve checks the arguments and wraps the result.");
 }

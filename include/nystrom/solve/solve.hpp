@@ -86,6 +86,9 @@ struct SolveOptions {
   /// Called with the checkpoint as text (to_text; float, double and long double states) when it is
   /// taken, if set: e.g. to write it to a file (write_checkpoint_text) while the run goes on.
   std::function<void(const std::string& checkpoint_text)> on_checkpoint{};
+  /// Called at every accepted step end with its time, if set (a progress display, an interruption
+  /// check); an exception it throws ends the run and leaves solve() unchanged.
+  std::function<void(double t)> on_step{};
 };
 
 /// An event function g(t, q, v): its zeros are located (direction: +1 rising only, -1 falling only,
@@ -259,6 +262,7 @@ class Recorder {
   /// A step ended at (t, q, v); true when a terminal event ends the run inside it (the solution's
   /// final state is then set to the event's).
   bool step(const R& t, const V& q, const V& v) {
+    if (opt_.on_step) opt_.on_step(as_double(t));
     V a = q;
     if (need_a_) accel(t, q, a);
     // Events in this step, the earliest first.
