@@ -537,41 +537,22 @@ class AdaptiveMpeIntegrator {
     obs(static_cast<const real_type&>(t0), static_cast<const State<V>&>(s_io));
     if (t1 == t0) return st;
 
-    const real_type span = t1 - t0;
-    real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
     const real_type tol(opt_.tol);
-    const real_type eps = epsilon_of<real_type>();
-    real_type h;
-    adaptive_detail::StepController ctl(opt_);
-    bool last_rejected = false;
-    const bool resume = resume_.valid && resume_.t == t0;
-    resume_.valid = false;
-    if (resume) {
-      h = resume_.h_want;
-      hmax = resume_.hmax;
-      last_rejected = resume_.last_rejected;
-      ctl.restore(resume_.q_prev, resume_.h_prev);
-    } else if (opt_.h0 > 0) {
-      h = real_type(opt_.h0);
-    } else if (h_next_ > real_type(0)) {
-      h = h_next_;
-    } else {
+    adaptive_detail::StepSequence<real_type> seq(opt_, resume_, h_next_, t0, t1, [&](const real_type& hmax) {
       long calls = 0;
       auto counted = [&](const V& q, V& a) {
         ++calls;
         base_.force()(q, a);
       };
-      h = adaptive_detail::hairer_initial_step<V>(counted, s_io, hmax, tol, method_order_);
+      const real_type h = adaptive_detail::hairer_initial_step<V>(counted, s_io, hmax, tol, method_order_);
       extra_evals_ += calls;
-    }
-    h = std::min(h, hmax);
+      return h;
+    });
 
     // Exponents on the squared norm: err^(-1/(p+1)) = (err^2)^(-1/(2(p+1))).
     const double p1 = opt_.error_order + 1;
     const double expo = -0.5 / p1;
-    const real_type tiny = real_type(16) * eps * std::max(abs(t0), abs(t1));
-    real_type t = t0;
-    real_type h_want = h;
+    real_type t = t0, h;
     bool error_finite = true;  // the last error estimate was finite (else the force returned NaN or inf)
 
     constexpr bool local = K > 0;
@@ -609,26 +590,15 @@ class AdaptiveMpeIntegrator {
     while (t < t1) {
       if (accepted + rejected >= opt_.max_steps) {
         store();
-        throw TooManySteps("adaptive MPE: more than " + std::to_string(opt_.max_steps) +
-                           " steps before reaching t1 = " + sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
+        adaptive_detail::throw_too_many_steps("adaptive MPE", opt_.max_steps, as_double(t), as_double(t1));
       }
-      h = h_want;
-      bool last = false;
-      if (t + h * real_type(1.01) >= t1) {
-        h = t1 - t;
-        last = true;
-      } else {
-        // A step whose end time is exactly representable: the time reached is then the sum of the
-        // steps taken, not its rounding (over 10^4 steps to t = 600 that rounding, ~1e-11 in time,
-        // would be the round-off floor of the position error on Kepler).
-        h = (t + h) - t;
-      }
-      if (!(h > tiny) || !(h > real_type(0))) {
+      // A step whose end time is exactly representable: the time reached is then the sum of the
+      // steps taken, not its rounding (over 10^4 steps to t = 600 that rounding, ~1e-11 in time,
+      // would be the round-off floor of the position error on Kepler).
+      bool last;
+      if (!seq.template next<true>(t, h, last)) {
         store();
-        throw StepSizeUnderflow("adaptive MPE: step size underflow at t = " + sci(as_double(t)) +
-                                " (h = " + sci(as_double(h)) + "): " +
-                                (error_finite ? "the tolerance cannot be met or the solution is singular"
-                                              : "the force returned NaN or infinity in this step"));
+        adaptive_detail::throw_underflow("adaptive MPE", as_double(t), as_double(h), error_finite);
       }
       if (!(local && verlet)) scale(h);
       if (kick_first_ && !a0_valid) {
@@ -661,19 +631,14 @@ class AdaptiveMpeIntegrator {
         last_h = as_double(h);
         const bool stop =
             adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
-        const double fac = ctl.accepted(std::pow(e2, expo), as_double(h), last_rejected);
-        const real_type hn = std::min(h * real_type(fac), hmax);
-        h_next_ = last && h < h_want ? h_want : hn;  // a step shortened to land on t1 keeps the proposal
-        h_want = hn;
-        last_rejected = false;
+        seq.accepted(std::pow(e2, expo), h, last, h_next_);
         if (stop && t < t1) {
-          resume_ = {t, h_want, hmax, false, ctl.q_prev(), ctl.h_prev(), true};
+          resume_ = seq.resume_point(t);
           break;
         }
       } else {
         ++rejected;
-        h_want = h * real_type(ctl.rejected(std::pow(e2, expo)));
-        last_rejected = true;
+        seq.rejected(std::pow(e2, expo), h);
       }
     }
     store();

@@ -209,17 +209,6 @@ class StepController {
   double q_prev_ = 0, h_prev_ = 0;  // of the last accepted step
 };
 
-/// Calls the observer; true when it asks the run to stop (an observer that returns bool).
-template <class Observer, class R, class St>
-bool observe(Observer& obs, const R& t, const St& s) {
-  if constexpr (std::is_same_v<std::invoke_result_t<Observer&, const R&, const St&>, bool>) {
-    return obs(t, s);
-  } else {
-    obs(t, s);
-    return false;
-  }
-}
-
 }  // namespace adaptive_detail
 
 /// Where an adaptive run stopped between two accepted steps, with all that its controller needs to
@@ -235,6 +224,106 @@ struct AdaptiveResumePoint {
   double q_prev = 0, h_prev = 0;
   bool valid = false;
 };
+
+namespace adaptive_detail {
+
+/// The step sizes of one integrate_to call of either adaptive engine, from t0 to t1: the first step
+/// (from the resume point at t0, else opt.h0, else the step carried over from the previous call
+/// h_carried, else the starting-step estimate starting_step(hmax)), the next step from t (shortened
+/// to land on t1, stretched when within 1% of it), and the proposals after an accepted or rejected
+/// step through StepController. The engine computes q = err^(-1/(p+1)) of each attempt.
+template <class R>
+class StepSequence {
+ public:
+  template <class Start>
+  StepSequence(const AdaptiveOptions& opt, AdaptiveResumePoint<R>& resume, const R& h_carried, const R& t0, const R& t1,
+               Start&& starting_step)
+      : ctl_(opt), t1_(t1) {
+    using std::abs;
+    const R span = t1 - t0;
+    hmax_ = opt.h_max > 0 ? std::min(span, R(opt.h_max)) : span;
+    R h;
+    const bool resumed = resume.valid && resume.t == t0;
+    resume.valid = false;
+    if (resumed) {
+      h = resume.h_want;
+      hmax_ = resume.hmax;
+      last_rejected_ = resume.last_rejected;
+      ctl_.restore(resume.q_prev, resume.h_prev);
+    } else if (opt.h0 > 0) {
+      h = R(opt.h0);
+    } else if (h_carried > R(0)) {
+      h = h_carried;
+    } else {
+      h = starting_step(static_cast<const R&>(hmax_));
+    }
+    h_want_ = std::min(h, hmax_);
+    tiny_ = R(16) * epsilon_of<R>() * std::max(abs(t0), abs(t1));
+  }
+
+  /// The next step h from t; last: it lands on t1. ExactEnd: a step that does not land on t1 is
+  /// rounded so that t + h is exactly representable. False when the step has fallen below the
+  /// rounding level of t (step-size underflow).
+  template <bool ExactEnd>
+  bool next(const R& t, R& h, bool& last) const {
+    h = h_want_;
+    last = false;
+    if (t + h * R(1.01) >= t1_) {
+      h = t1_ - t;
+      last = true;
+    } else if constexpr (ExactEnd) {
+      h = (t + h) - t;
+    }
+    return h > tiny_ && h > R(0);
+  }
+
+  /// After an accepted step h with ratio q: the next proposal, and into h_carried the step the next
+  /// call starts with (a step shortened to land on t1 keeps the earlier proposal).
+  void accepted(double q, const R& h, bool last, R& h_carried) {
+    const double fac = ctl_.accepted(q, as_double(h), last_rejected_);
+    const R hn = std::min(h * R(fac), hmax_);
+    h_carried = last && h < h_want_ ? h_want_ : hn;
+    h_want_ = hn;
+    last_rejected_ = false;
+  }
+  /// After a rejected step h with ratio q.
+  void rejected(double q, const R& h) {
+    h_want_ = h * R(ctl_.rejected(q));
+    last_rejected_ = true;
+  }
+  /// The point to go on from at t, after an accepted step.
+  AdaptiveResumePoint<R> resume_point(const R& t) const {
+    return {t, h_want_, hmax_, false, ctl_.q_prev(), ctl_.h_prev(), true};
+  }
+
+ private:
+  StepController ctl_;
+  R t1_, hmax_{}, h_want_{}, tiny_{};
+  bool last_rejected_ = false;
+};
+
+[[noreturn]] inline void throw_too_many_steps(const char* engine, long max_steps, double t, double t1) {
+  throw TooManySteps(std::string(engine) + ": more than " + std::to_string(max_steps) +
+                     " steps before reaching t1 = " + sci(t1) + " (at t = " + sci(t) + ")");
+}
+[[noreturn]] inline void throw_underflow(const char* engine, double t, double h, bool error_finite) {
+  throw StepSizeUnderflow(std::string(engine) + ": step size underflow at t = " + sci(t) + " (h = " + sci(h) + "): " +
+                          (error_finite ? "the tolerance cannot be met or the solution is singular"
+                                        : "the force returned NaN or infinity in this step"));
+}
+
+/// Calls the observer; true when it asks the run to stop (an observer that returns bool).
+template <class Observer, class R, class St>
+bool observe(Observer& obs, const R& t, const St& s) {
+  if constexpr (std::is_same_v<std::invoke_result_t<Observer&, const R&, const St&>, bool>) {
+    return obs(t, s);
+  } else {
+    obs(t, s);
+    return false;
+  }
+}
+
+}  // namespace adaptive_detail
 
 template <class V, class Force>
 class AdaptiveRknIntegrator {
@@ -277,52 +366,22 @@ class AdaptiveRknIntegrator {
     obs(static_cast<const real_type&>(t0), static_cast<const State<V>&>(s));
     if (t1 == t0) return st;
 
-    const real_type span = t1 - t0;
-    real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
     const real_type tol(opt_.tol);
-    const real_type eps = epsilon_of<real_type>();
-    real_type h;
     long extra_evals = 0;
-    adaptive_detail::StepController ctl(opt_);
-    bool last_rejected = false;
-    const bool resume = resume_.valid && resume_.t == t0;
-    resume_.valid = false;
-    if (resume) {
-      h = resume_.h_want;
-      hmax = resume_.hmax;
-      last_rejected = resume_.last_rejected;
-      ctl.restore(resume_.q_prev, resume_.h_prev);
-    } else if (opt_.h0 > 0) {
-      h = real_type(opt_.h0);
-    } else if (h_next_ > real_type(0)) {
-      h = h_next_;
-    } else {
-      h = initial_step(s, hmax, tol);
+    adaptive_detail::StepSequence<real_type> seq(opt_, resume_, h_next_, t0, t1, [&](const real_type& hmax) {
       extra_evals = 2;
-    }
-    h = std::min(h, hmax);
-
+      return initial_step(s, hmax, tol);
+    });
     const double expo = -1.0 / (opt_.error_order + 1);
-    const real_type tiny = real_type(16) * eps * std::max(abs(t0), abs(t1));
-    real_type t = t0;
-    real_type h_want = h;      // the controller's proposal for the next step
+    real_type t = t0, h;
     bool error_finite = true;  // the last error estimate was finite (else the force returned NaN or inf)
     State<V> y = s, err;
     while (t < t1) {
       if (st.accepted + st.rejected >= opt_.max_steps)
-        throw TooManySteps("adaptive RKN: more than " + std::to_string(opt_.max_steps) +
-                           " steps before reaching t1 = " + sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
-      h = h_want;
-      bool last = false;
-      if (t + h * real_type(1.01) >= t1) {
-        h = t1 - t;
-        last = true;
-      }
-      if (!(h > tiny) || !(h > real_type(0)))
-        throw StepSizeUnderflow("adaptive RKN: step size underflow at t = " + sci(as_double(t)) +
-                                " (h = " + sci(as_double(h)) + "): " +
-                                (error_finite ? "the tolerance cannot be met or the solution is singular"
-                                              : "the force returned NaN or infinity in this step"));
+        adaptive_detail::throw_too_many_steps("adaptive RKN", opt_.max_steps, as_double(t), as_double(t1));
+      bool last;
+      if (!seq.template next<false>(t, h, last))
+        adaptive_detail::throw_underflow("adaptive RKN", as_double(t), as_double(h), error_finite);
       assign_state(y, s);
       stepper_.step_with_error(y, h, err);
       const double e = error_norm(s, y, err, tol);  // the controller works in double: 2 digits suffice
@@ -334,19 +393,14 @@ class AdaptiveRknIntegrator {
         st.last_h = as_double(h);
         const bool stop =
             adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
-        const double fac = ctl.accepted(std::pow(e, expo), as_double(h), last_rejected);
-        // After a step shortened to land on t1, keep the earlier proposal for the next call.
-        h_next_ = last && h < h_want ? h_want : std::min(h * real_type(fac), hmax);
-        h_want = std::min(h * real_type(fac), hmax);
-        last_rejected = false;
+        seq.accepted(std::pow(e, expo), h, last, h_next_);
         if (stop && t < t1) {
-          resume_ = {t, h_want, hmax, false, ctl.q_prev(), ctl.h_prev(), true};
+          resume_ = seq.resume_point(t);
           break;
         }
       } else {
         ++st.rejected;
-        h_want = h * real_type(ctl.rejected(std::pow(e, expo)));
-        last_rejected = true;
+        seq.rejected(std::pow(e, expo), h);
       }
     }
     st.force_evals = stepper_.force_evals() - evals_before + extra_evals;

@@ -591,21 +591,6 @@ struct StepEnds {
     }
     return false;
   }
-  /// Runs advance() (the engine from where it stands to the end, observed by *this) until the end or a
-  /// terminal event; where it stopped for the checkpoint, fill(c) completes the checkpoint c and the
-  /// engine goes on from its resume point (the same steps as without the stop).
-  template <class Advance, class Fill>
-  void drive(Solution<V>& sol, Advance&& advance, Fill&& fill) {
-    for (;;) {
-      want_checkpoint = false;
-      advance();
-      if (terminal || !want_checkpoint) break;
-      Checkpoint<R> c;
-      fill(c);
-      c.output_force_evals = sol.output_force_evals;
-      run.take(c, sol);
-    }
-  }
   void finish(Solution<V>& sol) const {
     if (sol.status == SolveStatus::success) {
       sol.t_final = run.prob.t1;
@@ -614,6 +599,34 @@ struct StepEnds {
     }
   }
 };
+
+/// Runs an adaptive or GBS engine from engine state s (user time t_start) to the end or a terminal
+/// event, recording every accepted step end. advance(obs) runs the engine from where it stands to the
+/// end under the observer obs(te, st) (te: engine time), which user_time(te) maps to the user's time
+/// (std::nullopt: a time not to record, the start that the engine reports again). Where the run stopped
+/// for the checkpoint, fill(c) completes the checkpoint c (and sets where the engine goes on), and
+/// the engine goes on from its resume point: the same steps as without the stop.
+template <class V, class F, class VE, class UserTime, class Advance, class Fill>
+void drive_engine(const Run<V, F, VE>& run, Recorder<V, SecondOrderProblem<V, F>>& rec, Solution<V>& sol,
+                  const real_t<typename V::value_type>& t_start, const State<VE>& s, UserTime&& user_time,
+                  Advance&& advance, Fill&& fill) {
+  using R = real_t<typename V::value_type>;
+  StepEnds<V, F, VE> ends(run, rec, t_start, s);
+  auto obs = [&](const R& te, const State<VE>& st) -> bool {
+    const std::optional<R> t = user_time(te);
+    return t ? ends(*t, st) : false;
+  };
+  for (;;) {
+    ends.want_checkpoint = false;
+    advance(obs);
+    if (ends.terminal || !ends.want_checkpoint) break;
+    Checkpoint<R> c;
+    fill(c);
+    c.output_force_evals = sol.output_force_evals;
+    run.take(c, sol);
+  }
+  ends.finish(sol);
+}
 
 template <class VE, class V, class F>
 void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
@@ -720,13 +733,13 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, const Me
     sol.output_force_evals = resume->output_force_evals;
   }
   Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir, run.propagated_method(def));
-  StepEnds<V, F, VE> ends(run, rec, sgn_mul(dir, tau), s);
-  auto obs = [&](const R& tt, const State<VE>& st) -> bool {
-    if (tt == tau) return false;  // the start
-    return ends(tt == tau1 ? prob.t1 : sgn_mul(dir, tt), st);
-  };
-  ends.drive(
-      sol, [&] { engine.integrate_to(s, tau, tau1, obs); },
+  drive_engine(
+      run, rec, sol, sgn_mul(dir, tau), s,
+      [&](const R& tt) -> std::optional<R> {
+        if (tt == tau) return std::nullopt;  // the start
+        return tt == tau1 ? prob.t1 : sgn_mul(dir, tt);
+      },
+      [&](auto& obs) { engine.integrate_to(s, tau, tau1, obs); },
       [&](Checkpoint<R>& c) {
         const auto& rp = engine.resume_point();
         c.engine = name;
@@ -752,7 +765,6 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, const Me
   sol.force_evals = evals0 + engine.total().force_evals;
   sol.accepted = acc0 + engine.total().accepted;
   sol.rejected = rej0 + engine.total().rejected;
-  ends.finish(sol);
 }
 
 template <class VE, class V, class F>
@@ -788,12 +800,10 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
     t_start = resume->t;
     sol.output_force_evals = resume->output_force_evals;
   }
-  StepEnds<V, F, VE> ends(run, rec, t_start, s);
-  auto obs = [&](const R& trel, const State<VE>& st) -> bool {
-    return ends(trel == span ? prob.t1 : sgn_mul(dir, R(tau0 + trel)), st);
-  };
-  ends.drive(
-      sol, [&] { g.integrate_to(s, span, obs); },
+  drive_engine(
+      run, rec, sol, t_start, s,
+      [&](const R& trel) -> std::optional<R> { return trel == span ? prob.t1 : sgn_mul(dir, R(tau0 + trel)); },
+      [&](auto& obs) { g.integrate_to(s, span, obs); },
       [&](Checkpoint<R>& c) {
         const auto& rp = g.resume_point();
         c.engine = "gbs";
@@ -811,7 +821,6 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
   sol.force_evals = g.force_evals();
   sol.accepted = g.steps();
   sol.rejected = g.rejected();
-  ends.finish(sol);
 }
 
 template <class V, class F>
