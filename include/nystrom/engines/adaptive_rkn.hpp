@@ -13,8 +13,8 @@
 //   st.accepted, st.rejected, st.force_evals, st.last_h                 // this call; ai.total() sums all calls
 //
 // V is std::array<T, N> or std::vector<T> with a real T (double, long double, float128, ...).
-// Errors: std::invalid_argument for bad input (tol <= 0 or not finite or below 10 eps of the scalar
-// type, t1 < t0, t0/t1 not finite,
+// Errors: std::invalid_argument for bad input (tol or atol negative or not finite, both zero, tol
+// below 10 eps of the scalar type, t1 < t0, t0/t1 not finite,
 // NaN/inf or inconsistent state, a tableau without embedded weights, bad options);
 // nystrom::StepSizeUnderflow (a std::runtime_error) when the step size falls below the rounding
 // level of t, which happens when the tolerance cannot be met (too strict for the scalar type) or
@@ -25,7 +25,9 @@
 //   * error estimate: the difference of the two solutions of the pair, in q (h^2 sum (b - bhat) f)
 //     and v (h sum (B - Bhat) f); the higher-order solution is propagated (local extrapolation);
 //   * norm: err = sqrt( (1/2n) sum_i (e_i / sc_i)^2 ) over all n positions and n velocities, with
-//     sc_i = tol * (1 + max(|y_i(t)|, |y_i(t+h)|)): mixed absolute/relative with one tolerance;
+//     sc_i = tol * (1 + max(|y_i(t)|, |y_i(t+h)|)): mixed absolute/relative with one tolerance
+//     (opt.atol 0 or equal to tol), or sc_i = atol + tol * max(|y_i(t)|, |y_i(t+h)|) with a separate
+//     absolute tolerance (tol 0: absolute only); adaptive_detail::ErrorScale;
 //   * accept when err <= 1; new h = h * min(fac_max, max(fac_min, safety * err^(-1/(p+1)))), p the
 //     lower order of the pair, or Gustafsson's predictive ratio when smaller (opt.predictive, on by
 //     default; adaptive_detail::StepController); after a rejection the step may not grow in the next
@@ -71,7 +73,8 @@
 namespace nystrom {
 
 struct AdaptiveOptions {
-  double tol = 1e-10;         // absolute and relative tolerance (see the norm above)
+  double tol = 1e-10;         // relative tolerance, and the absolute one when atol is 0 (see the norm above)
+  double atol = 0;            // absolute tolerance; 0 (or equal to tol): the mixed norm with tol alone
   double safety = 0.9;        // safety factor on the optimal step (see below)
   double fac_min = 0.2;       // smallest step ratio per step
   double fac_max = 4.0;       // largest step ratio per step
@@ -82,7 +85,10 @@ struct AdaptiveOptions {
   bool predictive = true;     // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
 
   void validate() const {
-    if (!std::isfinite(tol) || !(tol > 0)) throw std::invalid_argument("tolerance must be a positive finite number");
+    if (!std::isfinite(tol) || !(tol >= 0)) throw std::invalid_argument("tolerance must be a finite number >= 0");
+    if (!std::isfinite(atol) || !(atol >= 0))
+      throw std::invalid_argument("absolute tolerance must be a finite number >= 0");
+    if (!(tol > 0) && !(atol > 0)) throw std::invalid_argument("tolerance and absolute tolerance are both zero");
     if (!(safety > 0 && safety <= 1)) throw std::invalid_argument("safety factor must be in (0, 1]");
     if (!(fac_min > 0 && fac_min < 1)) throw std::invalid_argument("fac_min must be in (0, 1)");
     if (!(fac_max > 1 && std::isfinite(fac_max))) throw std::invalid_argument("fac_max must be a finite number > 1");
@@ -131,10 +137,24 @@ struct NoObserver {
   void operator()(const T&, const St&) const {}
 };
 
+/// The scale sc of the error of a component of size y (the larger of its sizes at both ends of the
+/// step): tol (1 + y) with one tolerance (atol 0 or equal to tol), atol + tol y with two.
+template <class R>
+class ErrorScale {
+ public:
+  explicit ErrorScale(const AdaptiveOptions& opt)
+      : tol_(opt.tol), atol_(opt.atol), mixed_(opt.atol == 0 || opt.atol == opt.tol) {}
+  R operator()(const R& y) const { return mixed_ ? R(tol_ * (R(1) + y)) : R(atol_ + tol_ * y); }
+
+ private:
+  R tol_, atol_;
+  bool mixed_;
+};
+
 /// Hairer's starting step (HNW I, II.4) for y' = F(y), y = (q, v), F = (v, a(q)): two force
 /// evaluations; norms in double (they only set the order of magnitude).
 template <class V, class F, class R>
-R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const R& tol, int order) {
+R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const ErrorScale<R>& scale, int order) {
   using std::abs;
   const std::size_t n = s.q.size();
   V a0 = s.q, a1 = s.q;
@@ -142,8 +162,8 @@ R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const R& tol, 
   auto norm = [&](auto&& comp) {
     double sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const R sq = tol * (R(1) + abs(s.q[i]));
-      const R sv = tol * (R(1) + abs(s.v[i]));
+      const R sq = scale(abs(s.q[i]));
+      const R sv = scale(abs(s.v[i]));
       const auto [x, y] = comp(i);
       const double rx = as_double(R(x / sq)), ry = as_double(R(y / sv));
       sum += rx * rx + ry * ry;
@@ -339,7 +359,7 @@ class AdaptiveRknIntegrator {
       : opt_(opt), stepper_(check(std::move(t)), std::move(force)) {
     opt_.validate();
     const double min_tol = 10 * as_double(epsilon_of<real_type>());
-    if (opt_.tol < min_tol)
+    if (opt_.tol > 0 && opt_.tol < min_tol)
       throw std::invalid_argument("tolerance " + sci(opt_.tol) + " is below what " + scalar_traits<real_type>::name() +
                                   " resolves (10 eps = " + sci(min_tol) + "); use a wider precision");
     if (opt_.error_order == 0) opt_.error_order = embedded_order(stepper_.tableau());
@@ -366,11 +386,11 @@ class AdaptiveRknIntegrator {
     obs(static_cast<const real_type&>(t0), static_cast<const State<V>&>(s));
     if (t1 == t0) return st;
 
-    const real_type tol(opt_.tol);
+    const adaptive_detail::ErrorScale<real_type> err_scale(opt_);
     long extra_evals = 0;
     adaptive_detail::StepSequence<real_type> seq(opt_, resume_, h_next_, t0, t1, [&](const real_type& hmax) {
       extra_evals = 2;
-      return initial_step(s, hmax, tol);
+      return adaptive_detail::hairer_initial_step(stepper_.force(), s, hmax, err_scale, method_order_);
     });
     const double expo = -1.0 / (opt_.error_order + 1);
     real_type t = t0, h;
@@ -384,7 +404,7 @@ class AdaptiveRknIntegrator {
         adaptive_detail::throw_underflow("adaptive RKN", as_double(t), as_double(h), error_finite);
       assign_state(y, s);
       stepper_.step_with_error(y, h, err);
-      const double e = error_norm(s, y, err, tol);  // the controller works in double: 2 digits suffice
+      const double e = error_norm(s, y, err, err_scale);  // the controller works in double: 2 digits suffice
       error_finite = e < std::numeric_limits<double>::infinity();
       if (e <= 1.0) {
         assign_state(s, y);
@@ -433,23 +453,19 @@ class AdaptiveRknIntegrator {
   }
 
   /// The mixed norm of the error estimate, in double (NaN or inf: +inf, i.e. reject).
-  double error_norm(const State<V>& y0, const State<V>& y1, const State<V>& e, const real_type& tol) const {
+  double error_norm(const State<V>& y0, const State<V>& y1, const State<V>& e,
+                    const adaptive_detail::ErrorScale<real_type>& scale) const {
     using std::abs;
     double sum = 0;
     const std::size_t n = y0.q.size();
     for (std::size_t i = 0; i < n; ++i) {
-      const real_type sq = tol * (real_type(1) + std::max(abs(y0.q[i]), abs(y1.q[i])));
-      const real_type sv = tol * (real_type(1) + std::max(abs(y0.v[i]), abs(y1.v[i])));
+      const real_type sq = scale(std::max(abs(y0.q[i]), abs(y1.q[i])));
+      const real_type sv = scale(std::max(abs(y0.v[i]), abs(y1.v[i])));
       const double rq = as_double(real_type(e.q[i] / sq)), rv = as_double(real_type(e.v[i] / sv));
       sum += rq * rq + rv * rv;
     }
     const double r = std::sqrt(sum / static_cast<double>(2 * n));
     return std::isfinite(r) ? r : std::numeric_limits<double>::infinity();
-  }
-
-  // Hairer's starting step (adaptive_detail::hairer_initial_step, shared with the adaptive MPE).
-  real_type initial_step(const State<V>& s, const real_type& hmax, const real_type& tol) {
-    return adaptive_detail::hairer_initial_step(stepper_.force(), s, hmax, tol, method_order_);
   }
 
   AdaptiveOptions opt_;

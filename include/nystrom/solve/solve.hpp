@@ -58,9 +58,10 @@ struct SolveOptions {
   /// Fixed step: the step size (the last step is shortened to end on t1), or the number of equal steps.
   double h = 0;
   long steps = 0;
-  /// Adaptive methods and GBS: the tolerance. The adaptive RKN and MPE engines use the mixed norm
-  /// sc_i = rtol (1 + |y_i|) (atol must be 0 or equal to rtol); GBS uses sc_i = atol + rtol |y_i|
-  /// (atol 0: atol = rtol).
+  /// Adaptive methods and GBS: the relative and absolute tolerances, finite and >= 0, not both 0. The
+  /// error of a component of size |y_i| is measured against sc_i = atol + rtol |y_i| (rtol 0: absolute
+  /// only). atol 0 means atol = rtol; the adaptive RKN and MPE engines then (and for atol = rtol) use
+  /// sc_i = rtol (1 + |y_i|), the same scale but for rounding.
   double rtol = 0;
   double atol = 0;
   /// Output times, monotone in the direction of integration, within the span (by partial steps of the
@@ -863,17 +864,17 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
   using VE = typename extended<V, td>::type;
   const bool gbs = def.info.name == "GBS" || def.info.family == "extrapolation";
   if (gbs || def.info.adaptive) {
-    if (!(opt.rtol > 0) || !std::isfinite(opt.rtol))
-      throw invalid_input("method '" + def.info.name + "' needs a positive finite tolerance (rtol)");
+    if (!(opt.rtol >= 0) || !std::isfinite(opt.rtol)) throw invalid_input("rtol must be finite and >= 0");
     if (!(opt.atol >= 0) || !std::isfinite(opt.atol)) throw invalid_input("atol must be finite and >= 0");
+    if (opt.rtol == 0 && opt.atol == 0)
+      throw invalid_input("method '" + def.info.name + "' needs a tolerance (rtol > 0 or atol > 0)");
     Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
     if (gbs) {
       run_gbs<VE>(run, sol, events, resume);
     } else {
-      if (opt.atol != 0 && opt.atol != opt.rtol)
-        throw invalid_input("the adaptive RKN and MPE engines take one tolerance (rtol; atol = rtol or 0)");
       AdaptiveOptions ao = opt.adaptive;
       ao.tol = opt.rtol;
+      ao.atol = opt.atol;
       ao.max_steps = opt.max_steps;
       if (std::holds_alternative<MpeDef>(def.build())) {
         auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);
