@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Command 2 of the README (and what CI runs): install the dependencies; check the formatting; build everything
-# in Release with warnings as errors (the tool, benchmarks, examples, Python module and every test) and run the
-# whole suite there (library, tool and Python tests, install check); build the tool and every test again under
-# AddressSanitizer + UBSan (leak detection on) and run the whole C++ suite and the install check there; build
-# the libFuzzer harnesses and run each for a fixed time.
+# Command 2 of the README (and what CI runs): install the dependencies; check the formatting and the layers of the
+# headers (scripts/check-layers.sh); build everything in Release with warnings as errors (the tool, benchmarks,
+# examples, Python module and every test) and run the whole suite there (library, tool and Python tests, install
+# check); build the tool and every test again under AddressSanitizer + UBSan (leak detection on) and run the whole
+# C++ suite and the install check there; build the libFuzzer harnesses and run each for a fixed time.
 # NYSTROM_FUZZ_SECONDS: seconds per fuzzer (default 20).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,6 +13,8 @@ start=$(date +%s)
 
 echo "== Formatting (clang-format-14, .clang-format)"
 bash scripts/check-format.sh
+echo "== Layers (inclusions point one way, docs/architecture.md)"
+bash scripts/check-layers.sh
 
 echo "== Release build (warnings as errors) and the whole suite at the shipped optimisation level"
 # Debian's python3 (numpy, pybind11): a python3 earlier on PATH may lack them.

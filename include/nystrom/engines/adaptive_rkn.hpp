@@ -62,13 +62,13 @@
 #include <utility>
 #include <variant>
 
-#include "nystrom/analysis/rkn_order_conditions.hpp"
 #include "nystrom/core/bignum.hpp"
 #include "nystrom/core/error.hpp"
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/methods/method.hpp"
 #include "nystrom/methods/method_data.hpp"
+#include "nystrom/methods/rkn_order_conditions.hpp"
 
 namespace nystrom {
 
