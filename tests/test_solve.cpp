@@ -10,11 +10,14 @@
 #include <string>
 #include <vector>
 
+#include "kepler_solve.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/solve.hpp"
 
 using namespace nystrom;
-using V2 = std::array<double, 2>;
+using nystrom::test::kepler;
+using nystrom::test::pos_err;
+using nystrom::test::V2;
 using Vd = std::vector<double>;
 // One force type for the tests of user-written forces on a std::vector state (each force type compiles
 // every engine once more); the capturing-lambda test keeps its own lambda type.
@@ -24,13 +27,6 @@ using VdTimeForce = std::function<void(double, const Vd&, Vd&)>;
 namespace {
 
 constexpr double pi = std::numbers::pi;
-
-SecondOrderProblem<V2, KeplerForce> kepler(double e, double t0, double t1) {
-  const auto s = KeplerProblem<double>(e).initial_state();
-  return SecondOrderProblem(KeplerForce{}, s.q, s.v, t0, t1);
-}
-
-double pos_err(const V2& q, const State<V2>& ex) { return std::hypot(q[0] - ex.q[0], q[1] - ex.q[1]); }
 
 }  // namespace
 
