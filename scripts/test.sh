@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Command 2 of the README (and what CI runs): install the dependencies; check the formatting; build the tool,
-# benchmarks, examples and Python module in Release with warnings as errors and run the tests that need the
-# optimised build there (the tool's tests, the Python tests, the install check); build the tool, every C++ test
-# and the libFuzzer harnesses with clang-14 under AddressSanitizer + UBSan (leak detection on), run the whole C++
-# suite there (the library's test programs are built only there) and each harness for a fixed time.
+# Command 2 of the README (and what CI runs): install the dependencies; check the formatting and the layers of the
+# headers (scripts/check-layers.sh); build the tool, benchmarks, examples and Python module in Release with warnings
+# as errors and run the tests that need the optimised build there (the tool's tests, the Python tests, the install
+# check); build the tool, every C++ test and the libFuzzer harnesses with clang-14 under AddressSanitizer + UBSan
+# (leak detection on), run the whole C++ suite there (the library's test programs are built only there) and each
+# harness for a fixed time.
 # NYSTROM_FUZZ_SECONDS: seconds per fuzzer (default 20).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,6 +14,8 @@ start=$(date +%s)
 
 echo "== Formatting (clang-format-14, .clang-format)"
 bash scripts/check-format.sh
+echo "== Layers (inclusions point one way, docs/architecture.md)"
+bash scripts/check-layers.sh
 
 echo "== Release build (warnings as errors): the tool's, Python and install tests at the shipped optimisation level"
 # Debian's python3 (numpy, pybind11): a python3 earlier on PATH may lack them.

@@ -24,28 +24,39 @@ namespace detail {
 // The force evaluations a fixed-step run of n steps makes (for the progress line; FSAL accounted).
 inline long expected_evals(const MethodDef& def, long n) { return n * std::max(1, def.info.forces_per_step); }
 
-template <class T>
-RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
-  HarmonicProblem<T> prob;
+// A fixed-step run of `def` on `prob` (KeplerProblem<T> or HarmonicProblem<T>, force Force) from its initial
+// state: req.steps_per_period * req.periods steps of a period / req.steps_per_period, the force counted for the
+// progress line. Fills the steps, force evaluations, step size and seconds of r; returns the final state.
+template <class T, class Force, class Problem, class Result>
+auto run_metered(const MethodDef& def, const RunRequest& req, const Problem& prob, Result& r) {
   const long n = req.steps_per_period * req.periods;
-  const T h = HarmonicProblem<T>::period() / T(req.steps_per_period);
+  const T h = Problem::period() / T(req.steps_per_period);
   auto s = prob.initial_state();
+  using V = decltype(s.q);
   const auto t0 = std::chrono::steady_clock::now();
   std::optional<RunMeter> meter;
   if (req.progress) meter.emplace(expected_evals(def, n), precision_cost(req.precision));
-  RealStateIntegrator<std::array<T, 1>, MeteredForce<HarmonicForce>> integ(
-      def, MeteredForce<HarmonicForce>{HarmonicForce{}, meter ? &*meter : nullptr}, EngineOptions{req.keep_complex});
+  RealStateIntegrator<V, MeteredForce<Force>> integ(def, MeteredForce<Force>{Force{}, meter ? &*meter : nullptr},
+                                                    EngineOptions{req.keep_complex});
   integ.integrate(s, h, n);
   if (meter) meter->finish();
   const long evals = integ.force_evals();
   const auto t1 = std::chrono::steady_clock::now();
-  RunReport r;
   r.steps = n;
   r.force_evals = evals;
   r.h = as_double(h);
   r.seconds = std::chrono::duration<double>(t1 - t0).count();
+  return s;
+}
+
+template <class T>
+RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
+  HarmonicProblem<T> prob;
+  RunReport r;
+  const auto s = run_metered<T, HarmonicForce>(def, req, prob, r);
   using std::abs;
-  const auto ex = prob.exact(h * T(n));
+  const T h = HarmonicProblem<T>::period() / T(req.steps_per_period);
+  const auto ex = prob.exact(h * T(r.steps));
   r.position_error = as_double(abs(s.q[0] - ex.q[0]));
   const T e = (s.q[0] * s.q[0] + s.v[0] * s.v[0]) / T(2);
   r.energy_error = as_double(abs(e - T(1) / T(2)) / (T(1) / T(2)));
@@ -57,25 +68,10 @@ RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
 template <class T>
 KeplerRunResult run_kepler_metered(const MethodDef& def, const RunRequest& req) {
   const KeplerProblem<T> prob(static_cast<T>(req.ecc));
-  const long n = req.steps_per_period * req.periods;
-  const T h = KeplerProblem<T>::period() / T(req.steps_per_period);
-  const auto s0 = prob.initial_state();
-  State<std::array<T, 2>> s = s0;
-  const auto t0 = std::chrono::steady_clock::now();
-  std::optional<RunMeter> meter;
-  if (req.progress) meter.emplace(expected_evals(def, n), precision_cost(req.precision));
-  RealStateIntegrator<std::array<T, 2>, MeteredForce<KeplerForce>> integ(
-      def, MeteredForce<KeplerForce>{KeplerForce{}, meter ? &*meter : nullptr}, EngineOptions{req.keep_complex});
-  integ.integrate(s, h, n);
-  if (meter) meter->finish();
-  const long evals = integ.force_evals();
-  const auto t1 = std::chrono::steady_clock::now();
   KeplerRunResult r;
-  r.steps = n;
-  r.force_evals = evals;
-  r.h = as_double(h);
-  r.seconds = std::chrono::duration<double>(t1 - t0).count();
-  nystrom::detail::kepler_diagnostics(r, prob, s0, s, h * T(n), req.periods);
+  const auto s = run_metered<T, KeplerForce>(def, req, prob, r);
+  const T h = KeplerProblem<T>::period() / T(req.steps_per_period);
+  nystrom::detail::kepler_diagnostics(r, prob, prob.initial_state(), s, h * T(r.steps), req.periods);
   return r;
 }
 

@@ -10,22 +10,18 @@
 #include <string>
 #include <vector>
 
+#include "kepler_solve.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/solve.hpp"
 
 using namespace nystrom;
-using V2 = std::array<double, 2>;
+using nystrom::test::kepler;
+using nystrom::test::pos_err;
+using nystrom::test::V2;
 
 namespace {
 
 constexpr double pi = std::numbers::pi;
-
-SecondOrderProblem<V2, KeplerForce> kepler(double e, double t0, double t1) {
-  const auto s = KeplerProblem<double>(e).initial_state();
-  return SecondOrderProblem(KeplerForce{}, s.q, s.v, t0, t1);
-}
-
-double pos_err(const V2& q, const State<V2>& ex) { return std::hypot(q[0] - ex.q[0], q[1] - ex.q[1]); }
 
 struct Errors {
   double ends = 0, inside = 0, hermite = 0;

@@ -10,11 +10,14 @@
 #include <string>
 #include <vector>
 
+#include "kepler_solve.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/solve.hpp"
 
 using namespace nystrom;
-using V2 = std::array<double, 2>;
+using nystrom::test::kepler;
+using nystrom::test::pos_err;
+using nystrom::test::V2;
 using Vd = std::vector<double>;
 // One force type for the tests of user-written forces on a std::vector state (each force type compiles
 // every engine once more); the capturing-lambda test keeps its own lambda type.
@@ -24,13 +27,6 @@ using VdTimeForce = std::function<void(double, const Vd&, Vd&)>;
 namespace {
 
 constexpr double pi = std::numbers::pi;
-
-SecondOrderProblem<V2, KeplerForce> kepler(double e, double t0, double t1) {
-  const auto s = KeplerProblem<double>(e).initial_state();
-  return SecondOrderProblem(KeplerForce{}, s.q, s.v, t0, t1);
-}
-
-double pos_err(const V2& q, const State<V2>& ex) { return std::hypot(q[0] - ex.q[0], q[1] - ex.q[1]); }
 
 }  // namespace
 
@@ -171,6 +167,42 @@ TEST(Solve, InvalidInputIsRefusedWithOneClearError) {
   // An adaptive method through the fixed-step factory is refused, never run with fixed steps.
   EXPECT_THROW(make_integrator<V2>(resolve_method("DP12-adaptive"), KeplerForce{}), invalid_input);
   EXPECT_THROW(make_integrator<V2>(resolve_method("M12-adaptive"), KeplerForce{}), invalid_input);
+}
+
+TEST(Solve, AdaptiveEnginesTakeSeparateAbsoluteAndRelativeTolerances) {
+  // An oscillator of amplitude 1e6 (q = A cos t, v = -A sin t): an absolute tolerance bounds the
+  // absolute error, a relative one the error relative to A, and each error follows its tolerance. With
+  // one tolerance (atol 0 or equal to rtol) the scale is rtol (1 + |y|), bitwise the same either way.
+  const double amp = 1e6, t1 = 10;
+  VdForce f = [](const Vd& q, Vd& a) { a[0] = -q[0]; };
+  const SecondOrderProblem prob(f, Vd{amp}, Vd{0.0}, 0.0, t1);
+  auto err = [&](const SolveOptions& o, const std::string& m) {
+    const auto sol = solve(prob, m, o);
+    return std::hypot(sol.q_final[0] - amp * std::cos(t1), sol.v_final[0] + amp * std::sin(t1));
+  };
+  for (const std::string m : {"DP12-adaptive", "M10-adaptive"}) {
+    SCOPED_TRACE(m);
+    const double abs_loose = err({.rtol = 0, .atol = 1e-3}, m), abs_tight = err({.rtol = 0, .atol = 1e-6}, m);
+    const double rel_loose = err({.rtol = 1e-8, .atol = 1e-300}, m);
+    const double rel_tight = err({.rtol = 1e-11, .atol = 1e-300}, m);
+    EXPECT_LT(abs_loose, 100 * 1e-3);
+    EXPECT_LT(abs_tight, 100 * 1e-6);
+    EXPECT_LT(rel_loose, 100 * 1e-8 * amp);
+    EXPECT_LT(rel_tight, 100 * 1e-11 * amp);
+    // A factor 1000 in either tolerance moves the error by more than 30 (order p: 1000^(p/(p+1))).
+    EXPECT_GT(abs_loose, 30 * abs_tight);
+    EXPECT_GT(rel_loose, 30 * rel_tight);
+    // The relative tolerance 1e-6 alone allows errors of about 1e-6 A, far above the absolute 1e-6.
+    EXPECT_GT(err({.rtol = 1e-6, .atol = 1e-300}, m), 1e4 * abs_tight);
+    const auto one = solve(prob, m, {.rtol = 1e-9}), both = solve(prob, m, {.rtol = 1e-9, .atol = 1e-9});
+    EXPECT_EQ(one.q_final[0], both.q_final[0]);
+    EXPECT_EQ(one.v_final[0], both.v_final[0]);
+    EXPECT_EQ(one.force_evals, both.force_evals);
+    for (const SolveOptions& bad :
+         {SolveOptions{.rtol = -1e-9}, SolveOptions{.rtol = 1e-9, .atol = -1}, SolveOptions{.rtol = NAN},
+          SolveOptions{.rtol = 1e-9, .atol = NAN}, SolveOptions{.rtol = 0, .atol = 0}})
+      EXPECT_THROW(solve(prob, m, bad), invalid_input);
+  }
 }
 
 TEST(Solve, AForceReturningNaNIsReportedWithTheTime) {

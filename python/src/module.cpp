@@ -19,6 +19,7 @@
 
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/analysis/bch_report.hpp"
+#include "nystrom/analysis/method_file.hpp"  // installs the reader of "file:" method specifications
 #include "nystrom/engines/mpe.hpp"
 #include "nystrom/experiments/kepler.hpp"
 #include "nystrom/methods/catalog.hpp"

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "nystrom/analysis/bch.hpp"
+#include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/method.hpp"
 
 namespace nystrom::analysis {
@@ -325,5 +326,9 @@ inline std::string format_method_file(const std::string& name, int order, const 
   }
   return o.str();
 }
+
+/// Installs method_def_from_file as the reader of "file:PATH" specifications (methods/catalog.hpp) in
+/// every program that includes this header.
+inline const bool method_file_reader_installed = (set_method_file_reader(&method_def_from_file), true);
 
 }  // namespace nystrom::analysis

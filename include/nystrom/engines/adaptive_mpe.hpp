@@ -19,15 +19,15 @@
 //   nystrom::AdaptiveStats st = ai.integrate_to(state, t0, t1 [, observer]);
 //
 // The controller is that of AdaptiveRknIntegrator: mixed norm sqrt((1/2n) sum (e_i / sc_i)^2) with
-// sc_i = tol (1 + max(|y_i(t)|, |y_i(t+h)|)); accept when <= 1; h *= min(fac_max, max(fac_min,
-// safety err^(-1/(p+1)))), p = 2n - 2, or Gustafsson's predictive ratio when smaller (the default,
-// adaptive_detail::StepController); no growth right after a rejection; Hairer's starting step unless
-// opt.h0 > 0; the last step lands exactly on t1; exact force counting (rejected steps and the
-// starting-step estimate included). There is no PI term: on Kepler e = 0.9 with M12, a PI controller
-// with the usual beta drives the error far below the tolerance, which only rescales tol. The predictive
-// ratio matters on Kepler e = 0.9, where the optimal step falls by ~30% per step towards pericentre,
-// faster than the standard ratio follows: with the standard ratio M14-adaptive rejects 500-700 steps
-// per 3000 accepted, with the predictive one 0-100, and the same final error costs 25-35% less time.
+// sc_i = tol (1 + max(|y_i(t)|, |y_i(t+h)|)) (or atol + tol max(...) with opt.atol); accept when <= 1; h *=
+// min(fac_max, max(fac_min, safety err^(-1/(p+1)))), p = 2n - 2, or Gustafsson's predictive ratio when smaller (the
+// default, adaptive_detail::StepController); no growth right after a rejection; Hairer's starting step unless opt.h0 >
+// 0; the last step lands exactly on t1; exact force counting (rejected steps and the starting-step estimate included).
+// There is no PI term: on Kepler e = 0.9 with M12, a PI controller with the usual beta drives the error far below the
+// tolerance, which only rescales tol. The predictive ratio matters on Kepler e = 0.9, where the optimal step falls by
+// ~30% per step towards pericentre, faster than the standard ratio follows: with the standard ratio M14-adaptive
+// rejects 500-700 steps per 3000 accepted, with the predictive one 0-100, and the same final error costs 25-35% less
+// time.
 //
 // Cost per step: sum k_i force evaluations (+1 for a base that starts with a kick: the force at q_0,
 // shared by all products and kept across a rejected step). The products of a step run in lockstep so
@@ -131,7 +131,7 @@ class AdaptiveMpeIntegrator {
       if (!is_finite_scalar(c_[i]) || !is_finite_scalar(d_[i]))
         throw std::invalid_argument("adaptive MPE: coefficient is not finite");
     const double min_tol = 10 * as_double(epsilon_of<real_type>());
-    if (opt_.tol < min_tol)
+    if (opt_.tol > 0 && opt_.tol < min_tol)
       throw std::invalid_argument("tolerance " + sci(opt_.tol) + " is below what " + scalar_traits<real_type>::name() +
                                   " resolves (10 eps = " + sci(min_tol) + "); use a wider precision");
     if (eopt_.mpe_schedule == MpeSchedule::concurrent)
@@ -512,14 +512,15 @@ class AdaptiveMpeIntegrator {
   }
 
   /// The mixed norm of the error estimate, squared, in double (NaN or inf: +inf, i.e. reject).
-  static double error_norm2(const State<V>& y0, const State<V>& inc, const State<V>& e, const real_type& tol) {
+  static double error_norm2(const State<V>& y0, const State<V>& inc, const State<V>& e,
+                            const adaptive_detail::ErrorScale<real_type>& sc) {
     using std::abs;
     double sum = 0;
     const std::size_t n = y0.q.size();
     for (std::size_t i = 0; i < n; ++i) {
       const real_type q1 = y0.q[i] + inc.q[i], v1 = y0.v[i] + inc.v[i];
-      const real_type sq = tol * (real_type(1) + std::max(abs(y0.q[i]), abs(q1)));
-      const real_type sv = tol * (real_type(1) + std::max(abs(y0.v[i]), abs(v1)));
+      const real_type sq = sc(std::max(abs(y0.q[i]), abs(q1)));
+      const real_type sv = sc(std::max(abs(y0.v[i]), abs(v1)));
       const double rq = as_double(real_type(e.q[i] / sq)), rv = as_double(real_type(e.v[i] / sv));
       sum += rq * rq + rv * rv;
     }
@@ -537,41 +538,22 @@ class AdaptiveMpeIntegrator {
     obs(static_cast<const real_type&>(t0), static_cast<const State<V>&>(s_io));
     if (t1 == t0) return st;
 
-    const real_type span = t1 - t0;
-    real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
-    const real_type tol(opt_.tol);
-    const real_type eps = epsilon_of<real_type>();
-    real_type h;
-    adaptive_detail::StepController ctl(opt_);
-    bool last_rejected = false;
-    const bool resume = resume_.valid && resume_.t == t0;
-    resume_.valid = false;
-    if (resume) {
-      h = resume_.h_want;
-      hmax = resume_.hmax;
-      last_rejected = resume_.last_rejected;
-      ctl.restore(resume_.q_prev, resume_.h_prev);
-    } else if (opt_.h0 > 0) {
-      h = real_type(opt_.h0);
-    } else if (h_next_ > real_type(0)) {
-      h = h_next_;
-    } else {
+    const adaptive_detail::ErrorScale<real_type> err_scale(opt_);
+    adaptive_detail::StepSequence<real_type> seq(opt_, resume_, h_next_, t0, t1, [&](const real_type& hmax) {
       long calls = 0;
       auto counted = [&](const V& q, V& a) {
         ++calls;
         base_.force()(q, a);
       };
-      h = adaptive_detail::hairer_initial_step<V>(counted, s_io, hmax, tol, method_order_);
+      const real_type h = adaptive_detail::hairer_initial_step<V>(counted, s_io, hmax, err_scale, method_order_);
       extra_evals_ += calls;
-    }
-    h = std::min(h, hmax);
+      return h;
+    });
 
     // Exponents on the squared norm: err^(-1/(p+1)) = (err^2)^(-1/(2(p+1))).
     const double p1 = opt_.error_order + 1;
     const double expo = -0.5 / p1;
-    const real_type tiny = real_type(16) * eps * std::max(abs(t0), abs(t1));
-    real_type t = t0;
-    real_type h_want = h;
+    real_type t = t0, h;
     bool error_finite = true;  // the last error estimate was finite (else the force returned NaN or inf)
 
     constexpr bool local = K > 0;
@@ -609,26 +591,15 @@ class AdaptiveMpeIntegrator {
     while (t < t1) {
       if (accepted + rejected >= opt_.max_steps) {
         store();
-        throw TooManySteps("adaptive MPE: more than " + std::to_string(opt_.max_steps) +
-                           " steps before reaching t1 = " + sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
+        adaptive_detail::throw_too_many_steps("adaptive MPE", opt_.max_steps, as_double(t), as_double(t1));
       }
-      h = h_want;
-      bool last = false;
-      if (t + h * real_type(1.01) >= t1) {
-        h = t1 - t;
-        last = true;
-      } else {
-        // A step whose end time is exactly representable: the time reached is then the sum of the
-        // steps taken, not its rounding (over 10^4 steps to t = 600 that rounding, ~1e-11 in time,
-        // would be the round-off floor of the position error on Kepler).
-        h = (t + h) - t;
-      }
-      if (!(h > tiny) || !(h > real_type(0))) {
+      // A step whose end time is exactly representable: the time reached is then the sum of the
+      // steps taken, not its rounding (over 10^4 steps to t = 600 that rounding, ~1e-11 in time,
+      // would be the round-off floor of the position error on Kepler).
+      bool last;
+      if (!seq.template next<true>(t, h, last)) {
         store();
-        throw StepSizeUnderflow("adaptive MPE: step size underflow at t = " + sci(as_double(t)) +
-                                " (h = " + sci(as_double(h)) + "): " +
-                                (error_finite ? "the tolerance cannot be met or the solution is singular"
-                                              : "the force returned NaN or infinity in this step"));
+        adaptive_detail::throw_underflow("adaptive MPE", as_double(t), as_double(h), error_finite);
       }
       if (!(local && verlet)) scale(h);
       if (kick_first_ && !a0_valid) {
@@ -643,7 +614,7 @@ class AdaptiveMpeIntegrator {
           trial<Comp>(std::integral_constant<std::size_t, K>{}, s, a0, lx, la, lcq, lcv, inc, err);
       } else
         trial<Comp>(k_.size(), s, a0, xs_, as_, cqs_, cvs_, inc, err);
-      const double e2 = error_norm2(s, inc, err, tol);
+      const double e2 = error_norm2(s, inc, err, err_scale);
       error_finite = e2 < std::numeric_limits<double>::infinity();
       if (e2 <= 1.0) {
         for (std::size_t j = 0; j < s.q.size(); ++j) {
@@ -661,19 +632,14 @@ class AdaptiveMpeIntegrator {
         last_h = as_double(h);
         const bool stop =
             adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
-        const double fac = ctl.accepted(std::pow(e2, expo), as_double(h), last_rejected);
-        const real_type hn = std::min(h * real_type(fac), hmax);
-        h_next_ = last && h < h_want ? h_want : hn;  // a step shortened to land on t1 keeps the proposal
-        h_want = hn;
-        last_rejected = false;
+        seq.accepted(std::pow(e2, expo), h, last, h_next_);
         if (stop && t < t1) {
-          resume_ = {t, h_want, hmax, false, ctl.q_prev(), ctl.h_prev(), true};
+          resume_ = seq.resume_point(t);
           break;
         }
       } else {
         ++rejected;
-        h_want = h * real_type(ctl.rejected(std::pow(e2, expo)));
-        last_rejected = true;
+        seq.rejected(std::pow(e2, expo), h);
       }
     }
     store();

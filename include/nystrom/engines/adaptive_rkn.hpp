@@ -13,8 +13,8 @@
 //   st.accepted, st.rejected, st.force_evals, st.last_h                 // this call; ai.total() sums all calls
 //
 // V is std::array<T, N> or std::vector<T> with a real T (double, long double, float128, ...).
-// Errors: std::invalid_argument for bad input (tol <= 0 or not finite or below 10 eps of the scalar
-// type, t1 < t0, t0/t1 not finite,
+// Errors: std::invalid_argument for bad input (tol or atol negative or not finite, both zero, tol
+// below 10 eps of the scalar type, t1 < t0, t0/t1 not finite,
 // NaN/inf or inconsistent state, a tableau without embedded weights, bad options);
 // nystrom::StepSizeUnderflow (a std::runtime_error) when the step size falls below the rounding
 // level of t, which happens when the tolerance cannot be met (too strict for the scalar type) or
@@ -25,7 +25,9 @@
 //   * error estimate: the difference of the two solutions of the pair, in q (h^2 sum (b - bhat) f)
 //     and v (h sum (B - Bhat) f); the higher-order solution is propagated (local extrapolation);
 //   * norm: err = sqrt( (1/2n) sum_i (e_i / sc_i)^2 ) over all n positions and n velocities, with
-//     sc_i = tol * (1 + max(|y_i(t)|, |y_i(t+h)|)): mixed absolute/relative with one tolerance;
+//     sc_i = tol * (1 + max(|y_i(t)|, |y_i(t+h)|)): mixed absolute/relative with one tolerance
+//     (opt.atol 0 or equal to tol), or sc_i = atol + tol * max(|y_i(t)|, |y_i(t+h)|) with a separate
+//     absolute tolerance (tol 0: absolute only); adaptive_detail::ErrorScale;
 //   * accept when err <= 1; new h = h * min(fac_max, max(fac_min, safety * err^(-1/(p+1)))), p the
 //     lower order of the pair, or Gustafsson's predictive ratio when smaller (opt.predictive, on by
 //     default; adaptive_detail::StepController); after a rejection the step may not grow in the next
@@ -60,18 +62,19 @@
 #include <utility>
 #include <variant>
 
-#include "nystrom/analysis/rkn_order_conditions.hpp"
 #include "nystrom/core/bignum.hpp"
 #include "nystrom/core/error.hpp"
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/methods/method.hpp"
 #include "nystrom/methods/method_data.hpp"
+#include "nystrom/methods/rkn_order_conditions.hpp"
 
 namespace nystrom {
 
 struct AdaptiveOptions {
-  double tol = 1e-10;         // absolute and relative tolerance (see the norm above)
+  double tol = 1e-10;         // relative tolerance, and the absolute one when atol is 0 (see the norm above)
+  double atol = 0;            // absolute tolerance; 0 (or equal to tol): the mixed norm with tol alone
   double safety = 0.9;        // safety factor on the optimal step (see below)
   double fac_min = 0.2;       // smallest step ratio per step
   double fac_max = 4.0;       // largest step ratio per step
@@ -82,7 +85,10 @@ struct AdaptiveOptions {
   bool predictive = true;     // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
 
   void validate() const {
-    if (!std::isfinite(tol) || !(tol > 0)) throw std::invalid_argument("tolerance must be a positive finite number");
+    if (!std::isfinite(tol) || !(tol >= 0)) throw std::invalid_argument("tolerance must be a finite number >= 0");
+    if (!std::isfinite(atol) || !(atol >= 0))
+      throw std::invalid_argument("absolute tolerance must be a finite number >= 0");
+    if (!(tol > 0) && !(atol > 0)) throw std::invalid_argument("tolerance and absolute tolerance are both zero");
     if (!(safety > 0 && safety <= 1)) throw std::invalid_argument("safety factor must be in (0, 1]");
     if (!(fac_min > 0 && fac_min < 1)) throw std::invalid_argument("fac_min must be in (0, 1)");
     if (!(fac_max > 1 && std::isfinite(fac_max))) throw std::invalid_argument("fac_max must be a finite number > 1");
@@ -131,10 +137,24 @@ struct NoObserver {
   void operator()(const T&, const St&) const {}
 };
 
+/// The scale sc of the error of a component of size y (the larger of its sizes at both ends of the
+/// step): tol (1 + y) with one tolerance (atol 0 or equal to tol), atol + tol y with two.
+template <class R>
+class ErrorScale {
+ public:
+  explicit ErrorScale(const AdaptiveOptions& opt)
+      : tol_(opt.tol), atol_(opt.atol), mixed_(opt.atol == 0 || opt.atol == opt.tol) {}
+  R operator()(const R& y) const { return mixed_ ? R(tol_ * (R(1) + y)) : R(atol_ + tol_ * y); }
+
+ private:
+  R tol_, atol_;
+  bool mixed_;
+};
+
 /// Hairer's starting step (HNW I, II.4) for y' = F(y), y = (q, v), F = (v, a(q)): two force
 /// evaluations; norms in double (they only set the order of magnitude).
 template <class V, class F, class R>
-R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const R& tol, int order) {
+R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const ErrorScale<R>& scale, int order) {
   using std::abs;
   const std::size_t n = s.q.size();
   V a0 = s.q, a1 = s.q;
@@ -142,8 +162,8 @@ R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const R& tol, 
   auto norm = [&](auto&& comp) {
     double sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const R sq = tol * (R(1) + abs(s.q[i]));
-      const R sv = tol * (R(1) + abs(s.v[i]));
+      const R sq = scale(abs(s.q[i]));
+      const R sv = scale(abs(s.v[i]));
       const auto [x, y] = comp(i);
       const double rx = as_double(R(x / sq)), ry = as_double(R(y / sv));
       sum += rx * rx + ry * ry;
@@ -209,17 +229,6 @@ class StepController {
   double q_prev_ = 0, h_prev_ = 0;  // of the last accepted step
 };
 
-/// Calls the observer; true when it asks the run to stop (an observer that returns bool).
-template <class Observer, class R, class St>
-bool observe(Observer& obs, const R& t, const St& s) {
-  if constexpr (std::is_same_v<std::invoke_result_t<Observer&, const R&, const St&>, bool>) {
-    return obs(t, s);
-  } else {
-    obs(t, s);
-    return false;
-  }
-}
-
 }  // namespace adaptive_detail
 
 /// Where an adaptive run stopped between two accepted steps, with all that its controller needs to
@@ -236,6 +245,106 @@ struct AdaptiveResumePoint {
   bool valid = false;
 };
 
+namespace adaptive_detail {
+
+/// The step sizes of one integrate_to call of either adaptive engine, from t0 to t1: the first step
+/// (from the resume point at t0, else opt.h0, else the step carried over from the previous call
+/// h_carried, else the starting-step estimate starting_step(hmax)), the next step from t (shortened
+/// to land on t1, stretched when within 1% of it), and the proposals after an accepted or rejected
+/// step through StepController. The engine computes q = err^(-1/(p+1)) of each attempt.
+template <class R>
+class StepSequence {
+ public:
+  template <class Start>
+  StepSequence(const AdaptiveOptions& opt, AdaptiveResumePoint<R>& resume, const R& h_carried, const R& t0, const R& t1,
+               Start&& starting_step)
+      : ctl_(opt), t1_(t1) {
+    using std::abs;
+    const R span = t1 - t0;
+    hmax_ = opt.h_max > 0 ? std::min(span, R(opt.h_max)) : span;
+    R h;
+    const bool resumed = resume.valid && resume.t == t0;
+    resume.valid = false;
+    if (resumed) {
+      h = resume.h_want;
+      hmax_ = resume.hmax;
+      last_rejected_ = resume.last_rejected;
+      ctl_.restore(resume.q_prev, resume.h_prev);
+    } else if (opt.h0 > 0) {
+      h = R(opt.h0);
+    } else if (h_carried > R(0)) {
+      h = h_carried;
+    } else {
+      h = starting_step(static_cast<const R&>(hmax_));
+    }
+    h_want_ = std::min(h, hmax_);
+    tiny_ = R(16) * epsilon_of<R>() * std::max(abs(t0), abs(t1));
+  }
+
+  /// The next step h from t; last: it lands on t1. ExactEnd: a step that does not land on t1 is
+  /// rounded so that t + h is exactly representable. False when the step has fallen below the
+  /// rounding level of t (step-size underflow).
+  template <bool ExactEnd>
+  bool next(const R& t, R& h, bool& last) const {
+    h = h_want_;
+    last = false;
+    if (t + h * R(1.01) >= t1_) {
+      h = t1_ - t;
+      last = true;
+    } else if constexpr (ExactEnd) {
+      h = (t + h) - t;
+    }
+    return h > tiny_ && h > R(0);
+  }
+
+  /// After an accepted step h with ratio q: the next proposal, and into h_carried the step the next
+  /// call starts with (a step shortened to land on t1 keeps the earlier proposal).
+  void accepted(double q, const R& h, bool last, R& h_carried) {
+    const double fac = ctl_.accepted(q, as_double(h), last_rejected_);
+    const R hn = std::min(h * R(fac), hmax_);
+    h_carried = last && h < h_want_ ? h_want_ : hn;
+    h_want_ = hn;
+    last_rejected_ = false;
+  }
+  /// After a rejected step h with ratio q.
+  void rejected(double q, const R& h) {
+    h_want_ = h * R(ctl_.rejected(q));
+    last_rejected_ = true;
+  }
+  /// The point to go on from at t, after an accepted step.
+  AdaptiveResumePoint<R> resume_point(const R& t) const {
+    return {t, h_want_, hmax_, false, ctl_.q_prev(), ctl_.h_prev(), true};
+  }
+
+ private:
+  StepController ctl_;
+  R t1_, hmax_{}, h_want_{}, tiny_{};
+  bool last_rejected_ = false;
+};
+
+[[noreturn]] inline void throw_too_many_steps(const char* engine, long max_steps, double t, double t1) {
+  throw TooManySteps(std::string(engine) + ": more than " + std::to_string(max_steps) +
+                     " steps before reaching t1 = " + sci(t1) + " (at t = " + sci(t) + ")");
+}
+[[noreturn]] inline void throw_underflow(const char* engine, double t, double h, bool error_finite) {
+  throw StepSizeUnderflow(std::string(engine) + ": step size underflow at t = " + sci(t) + " (h = " + sci(h) + "): " +
+                          (error_finite ? "the tolerance cannot be met or the solution is singular"
+                                        : "the force returned NaN or infinity in this step"));
+}
+
+/// Calls the observer; true when it asks the run to stop (an observer that returns bool).
+template <class Observer, class R, class St>
+bool observe(Observer& obs, const R& t, const St& s) {
+  if constexpr (std::is_same_v<std::invoke_result_t<Observer&, const R&, const St&>, bool>) {
+    return obs(t, s);
+  } else {
+    obs(t, s);
+    return false;
+  }
+}
+
+}  // namespace adaptive_detail
+
 template <class V, class Force>
 class AdaptiveRknIntegrator {
   static std::string sci(double x) { return adaptive_detail::sci(x); }
@@ -250,7 +359,7 @@ class AdaptiveRknIntegrator {
       : opt_(opt), stepper_(check(std::move(t)), std::move(force)) {
     opt_.validate();
     const double min_tol = 10 * as_double(epsilon_of<real_type>());
-    if (opt_.tol < min_tol)
+    if (opt_.tol > 0 && opt_.tol < min_tol)
       throw std::invalid_argument("tolerance " + sci(opt_.tol) + " is below what " + scalar_traits<real_type>::name() +
                                   " resolves (10 eps = " + sci(min_tol) + "); use a wider precision");
     if (opt_.error_order == 0) opt_.error_order = embedded_order(stepper_.tableau());
@@ -277,55 +386,25 @@ class AdaptiveRknIntegrator {
     obs(static_cast<const real_type&>(t0), static_cast<const State<V>&>(s));
     if (t1 == t0) return st;
 
-    const real_type span = t1 - t0;
-    real_type hmax = opt_.h_max > 0 ? std::min(span, real_type(opt_.h_max)) : span;
-    const real_type tol(opt_.tol);
-    const real_type eps = epsilon_of<real_type>();
-    real_type h;
+    const adaptive_detail::ErrorScale<real_type> err_scale(opt_);
     long extra_evals = 0;
-    adaptive_detail::StepController ctl(opt_);
-    bool last_rejected = false;
-    const bool resume = resume_.valid && resume_.t == t0;
-    resume_.valid = false;
-    if (resume) {
-      h = resume_.h_want;
-      hmax = resume_.hmax;
-      last_rejected = resume_.last_rejected;
-      ctl.restore(resume_.q_prev, resume_.h_prev);
-    } else if (opt_.h0 > 0) {
-      h = real_type(opt_.h0);
-    } else if (h_next_ > real_type(0)) {
-      h = h_next_;
-    } else {
-      h = initial_step(s, hmax, tol);
+    adaptive_detail::StepSequence<real_type> seq(opt_, resume_, h_next_, t0, t1, [&](const real_type& hmax) {
       extra_evals = 2;
-    }
-    h = std::min(h, hmax);
-
+      return adaptive_detail::hairer_initial_step(stepper_.force(), s, hmax, err_scale, method_order_);
+    });
     const double expo = -1.0 / (opt_.error_order + 1);
-    const real_type tiny = real_type(16) * eps * std::max(abs(t0), abs(t1));
-    real_type t = t0;
-    real_type h_want = h;      // the controller's proposal for the next step
+    real_type t = t0, h;
     bool error_finite = true;  // the last error estimate was finite (else the force returned NaN or inf)
     State<V> y = s, err;
     while (t < t1) {
       if (st.accepted + st.rejected >= opt_.max_steps)
-        throw TooManySteps("adaptive RKN: more than " + std::to_string(opt_.max_steps) +
-                           " steps before reaching t1 = " + sci(as_double(t1)) + " (at t = " + sci(as_double(t)) + ")");
-      h = h_want;
-      bool last = false;
-      if (t + h * real_type(1.01) >= t1) {
-        h = t1 - t;
-        last = true;
-      }
-      if (!(h > tiny) || !(h > real_type(0)))
-        throw StepSizeUnderflow("adaptive RKN: step size underflow at t = " + sci(as_double(t)) +
-                                " (h = " + sci(as_double(h)) + "): " +
-                                (error_finite ? "the tolerance cannot be met or the solution is singular"
-                                              : "the force returned NaN or infinity in this step"));
+        adaptive_detail::throw_too_many_steps("adaptive RKN", opt_.max_steps, as_double(t), as_double(t1));
+      bool last;
+      if (!seq.template next<false>(t, h, last))
+        adaptive_detail::throw_underflow("adaptive RKN", as_double(t), as_double(h), error_finite);
       assign_state(y, s);
       stepper_.step_with_error(y, h, err);
-      const double e = error_norm(s, y, err, tol);  // the controller works in double: 2 digits suffice
+      const double e = error_norm(s, y, err, err_scale);  // the controller works in double: 2 digits suffice
       error_finite = e < std::numeric_limits<double>::infinity();
       if (e <= 1.0) {
         assign_state(s, y);
@@ -334,19 +413,14 @@ class AdaptiveRknIntegrator {
         st.last_h = as_double(h);
         const bool stop =
             adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
-        const double fac = ctl.accepted(std::pow(e, expo), as_double(h), last_rejected);
-        // After a step shortened to land on t1, keep the earlier proposal for the next call.
-        h_next_ = last && h < h_want ? h_want : std::min(h * real_type(fac), hmax);
-        h_want = std::min(h * real_type(fac), hmax);
-        last_rejected = false;
+        seq.accepted(std::pow(e, expo), h, last, h_next_);
         if (stop && t < t1) {
-          resume_ = {t, h_want, hmax, false, ctl.q_prev(), ctl.h_prev(), true};
+          resume_ = seq.resume_point(t);
           break;
         }
       } else {
         ++st.rejected;
-        h_want = h * real_type(ctl.rejected(std::pow(e, expo)));
-        last_rejected = true;
+        seq.rejected(std::pow(e, expo), h);
       }
     }
     st.force_evals = stepper_.force_evals() - evals_before + extra_evals;
@@ -379,23 +453,19 @@ class AdaptiveRknIntegrator {
   }
 
   /// The mixed norm of the error estimate, in double (NaN or inf: +inf, i.e. reject).
-  double error_norm(const State<V>& y0, const State<V>& y1, const State<V>& e, const real_type& tol) const {
+  double error_norm(const State<V>& y0, const State<V>& y1, const State<V>& e,
+                    const adaptive_detail::ErrorScale<real_type>& scale) const {
     using std::abs;
     double sum = 0;
     const std::size_t n = y0.q.size();
     for (std::size_t i = 0; i < n; ++i) {
-      const real_type sq = tol * (real_type(1) + std::max(abs(y0.q[i]), abs(y1.q[i])));
-      const real_type sv = tol * (real_type(1) + std::max(abs(y0.v[i]), abs(y1.v[i])));
+      const real_type sq = scale(std::max(abs(y0.q[i]), abs(y1.q[i])));
+      const real_type sv = scale(std::max(abs(y0.v[i]), abs(y1.v[i])));
       const double rq = as_double(real_type(e.q[i] / sq)), rv = as_double(real_type(e.v[i] / sv));
       sum += rq * rq + rv * rv;
     }
     const double r = std::sqrt(sum / static_cast<double>(2 * n));
     return std::isfinite(r) ? r : std::numeric_limits<double>::infinity();
-  }
-
-  // Hairer's starting step (adaptive_detail::hairer_initial_step, shared with the adaptive MPE).
-  real_type initial_step(const State<V>& s, const real_type& hmax, const real_type& tol) {
-    return adaptive_detail::hairer_initial_step(stepper_.force(), s, hmax, tol, method_order_);
   }
 
   AdaptiveOptions opt_;

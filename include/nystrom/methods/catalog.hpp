@@ -8,7 +8,8 @@
 //   M<2n>-adaptive        natural-sequence MPE with adaptive steps (engines/adaptive_mpe.hpp; needs a tolerance)
 //   mpe-adaptive:1,2,3    adaptive MPE on position Verlet (also mpe-pv-adaptive:), mpe-vv-adaptive: on velocity Verlet
 //   adjoint:NAME          the adjoint of a splitting method (sub-steps reversed)
-//   file:PATH             a splitting method from a method file (format: nystrom/analysis/method_file.hpp)
+//   file:PATH             a splitting method from a method file (nystrom/analysis/method_file.hpp, which
+//                         must be included: it installs the reader, set_method_file_reader)
 //   triplejump:P          Yoshida's triple jump of even order P on position Verlet (also triplejump-pv:P);
 //   triplejump-vv:P       on velocity Verlet (compositions.hpp)
 //   suzuki:P              Suzuki's 5-fold fractal composition of even order P on position Verlet
@@ -37,6 +38,13 @@ NYSTROM_DECL const std::vector<MethodDef>& catalog();
 
 /// Resolves a method specification (see the top of this file). Throws std::invalid_argument.
 NYSTROM_DECL MethodDef resolve_method(const std::string& spec);
+
+/// Reads the method file of a "file:PATH" specification. The method-file format, which verifies a file's
+/// declared order by the BCH expansion, lives above the methods (analysis/method_file.hpp); including
+/// that header installs its reader here, so that resolving a catalog method never compiles the BCH
+/// machinery. Without a reader, resolve_method refuses "file:" specifications.
+using MethodFileReader = MethodDef (*)(const std::string& path);
+NYSTROM_DECL void set_method_file_reader(MethodFileReader reader);
 
 }  // namespace nystrom
 

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "nystrom/core/bignum.hpp"
-#include "nystrom/engines/mpe.hpp"
-#include "nystrom/engines/rkn.hpp"
-#include "nystrom/engines/splitting.hpp"
+#include "nystrom/methods/mpe_coefficients.hpp"
+#include "nystrom/methods/rkn_tableau.hpp"
+#include "nystrom/methods/splitting_scheme.hpp"
 
 namespace nystrom {
 

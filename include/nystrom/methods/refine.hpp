@@ -43,9 +43,9 @@
 #include <variant>
 #include <vector>
 
-#include "nystrom/analysis/rkn_order_conditions.hpp"
 #include "nystrom/core/bignum.hpp"
 #include "nystrom/methods/method.hpp"
+#include "nystrom/methods/rkn_order_conditions.hpp"
 
 namespace nystrom {
 

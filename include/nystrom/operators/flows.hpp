@@ -28,7 +28,7 @@
 #include <utility>
 #include <vector>
 
-#include "nystrom/engines/splitting.hpp"  // SplittingScheme, normalized: method data only, not the classical engine
+#include "nystrom/methods/splitting_scheme.hpp"
 
 namespace nystrom::operators {
 

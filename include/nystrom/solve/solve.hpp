@@ -58,9 +58,10 @@ struct SolveOptions {
   /// Fixed step: the step size (the last step is shortened to end on t1), or the number of equal steps.
   double h = 0;
   long steps = 0;
-  /// Adaptive methods and GBS: the tolerance. The adaptive RKN and MPE engines use the mixed norm
-  /// sc_i = rtol (1 + |y_i|) (atol must be 0 or equal to rtol); GBS uses sc_i = atol + rtol |y_i|
-  /// (atol 0: atol = rtol).
+  /// Adaptive methods and GBS: the relative and absolute tolerances, finite and >= 0, not both 0. The
+  /// error of a component of size |y_i| is measured against sc_i = atol + rtol |y_i| (rtol 0: absolute
+  /// only). atol 0 means atol = rtol; the adaptive RKN and MPE engines then (and for atol = rtol) use
+  /// sc_i = rtol (1 + |y_i|), the same scale but for rounding.
   double rtol = 0;
   double atol = 0;
   /// Output times, monotone in the direction of integration, within the span (by partial steps of the
@@ -595,21 +596,6 @@ struct StepEnds {
     }
     return false;
   }
-  /// Runs advance() (the engine from where it stands to the end, observed by *this) until the end or a
-  /// terminal event; where it stopped for the checkpoint, fill(c) completes the checkpoint c and the
-  /// engine goes on from its resume point (the same steps as without the stop).
-  template <class Advance, class Fill>
-  void drive(Solution<V>& sol, Advance&& advance, Fill&& fill) {
-    for (;;) {
-      want_checkpoint = false;
-      advance();
-      if (terminal || !want_checkpoint) break;
-      Checkpoint<R> c;
-      fill(c);
-      c.output_force_evals = sol.output_force_evals;
-      run.take(c, sol);
-    }
-  }
   void finish(Solution<V>& sol) const {
     if (sol.status == SolveStatus::success) {
       sol.t_final = run.prob.t1;
@@ -618,6 +604,34 @@ struct StepEnds {
     }
   }
 };
+
+/// Runs an adaptive or GBS engine from engine state s (user time t_start) to the end or a terminal
+/// event, recording every accepted step end. advance(obs) runs the engine from where it stands to the
+/// end under the observer obs(te, st) (te: engine time), which user_time(te) maps to the user's time
+/// (std::nullopt: a time not to record, the start that the engine reports again). Where the run stopped
+/// for the checkpoint, fill(c) completes the checkpoint c (and sets where the engine goes on), and
+/// the engine goes on from its resume point: the same steps as without the stop.
+template <class V, class F, class VE, class UserTime, class Advance, class Fill>
+void drive_engine(const Run<V, F, VE>& run, Recorder<V, SecondOrderProblem<V, F>>& rec, Solution<V>& sol,
+                  const real_t<typename V::value_type>& t_start, const State<VE>& s, UserTime&& user_time,
+                  Advance&& advance, Fill&& fill) {
+  using R = real_t<typename V::value_type>;
+  StepEnds<V, F, VE> ends(run, rec, t_start, s);
+  auto obs = [&](const R& te, const State<VE>& st) -> bool {
+    const std::optional<R> t = user_time(te);
+    return t ? ends(*t, st) : false;
+  };
+  for (;;) {
+    ends.want_checkpoint = false;
+    advance(obs);
+    if (ends.terminal || !ends.want_checkpoint) break;
+    Checkpoint<R> c;
+    fill(c);
+    c.output_force_evals = sol.output_force_evals;
+    run.take(c, sol);
+  }
+  ends.finish(sol);
+}
 
 template <class VE, class V, class F>
 void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
@@ -724,13 +738,13 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, const Me
     sol.output_force_evals = resume->output_force_evals;
   }
   Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir, run.propagated_method(def));
-  StepEnds<V, F, VE> ends(run, rec, sgn_mul(dir, tau), s);
-  auto obs = [&](const R& tt, const State<VE>& st) -> bool {
-    if (tt == tau) return false;  // the start
-    return ends(tt == tau1 ? prob.t1 : sgn_mul(dir, tt), st);
-  };
-  ends.drive(
-      sol, [&] { engine.integrate_to(s, tau, tau1, obs); },
+  drive_engine(
+      run, rec, sol, sgn_mul(dir, tau), s,
+      [&](const R& tt) -> std::optional<R> {
+        if (tt == tau) return std::nullopt;  // the start
+        return tt == tau1 ? prob.t1 : sgn_mul(dir, tt);
+      },
+      [&](auto& obs) { engine.integrate_to(s, tau, tau1, obs); },
       [&](Checkpoint<R>& c) {
         const auto& rp = engine.resume_point();
         c.engine = name;
@@ -756,7 +770,6 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, const Me
   sol.force_evals = evals0 + engine.total().force_evals;
   sol.accepted = acc0 + engine.total().accepted;
   sol.rejected = rej0 + engine.total().rejected;
-  ends.finish(sol);
 }
 
 template <class VE, class V, class F>
@@ -792,12 +805,10 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
     t_start = resume->t;
     sol.output_force_evals = resume->output_force_evals;
   }
-  StepEnds<V, F, VE> ends(run, rec, t_start, s);
-  auto obs = [&](const R& trel, const State<VE>& st) -> bool {
-    return ends(trel == span ? prob.t1 : sgn_mul(dir, R(tau0 + trel)), st);
-  };
-  ends.drive(
-      sol, [&] { g.integrate_to(s, span, obs); },
+  drive_engine(
+      run, rec, sol, t_start, s,
+      [&](const R& trel) -> std::optional<R> { return trel == span ? prob.t1 : sgn_mul(dir, R(tau0 + trel)); },
+      [&](auto& obs) { g.integrate_to(s, span, obs); },
       [&](Checkpoint<R>& c) {
         const auto& rp = g.resume_point();
         c.engine = "gbs";
@@ -815,7 +826,6 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
   sol.force_evals = g.force_evals();
   sol.accepted = g.steps();
   sol.rejected = g.rejected();
-  ends.finish(sol);
 }
 
 template <class V, class F>
@@ -858,17 +868,17 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
   using VE = typename extended<V, td>::type;
   const bool gbs = def.info.name == "GBS" || def.info.family == "extrapolation";
   if (gbs || def.info.adaptive) {
-    if (!(opt.rtol > 0) || !std::isfinite(opt.rtol))
-      throw invalid_input("method '" + def.info.name + "' needs a positive finite tolerance (rtol)");
+    if (!(opt.rtol >= 0) || !std::isfinite(opt.rtol)) throw invalid_input("rtol must be finite and >= 0");
     if (!(opt.atol >= 0) || !std::isfinite(opt.atol)) throw invalid_input("atol must be finite and >= 0");
+    if (opt.rtol == 0 && opt.atol == 0)
+      throw invalid_input("method '" + def.info.name + "' needs a tolerance (rtol > 0 or atol > 0)");
     Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
     if (gbs) {
       run_gbs<VE>(run, sol, events, resume);
     } else {
-      if (opt.atol != 0 && opt.atol != opt.rtol)
-        throw invalid_input("the adaptive RKN and MPE engines take one tolerance (rtol; atol = rtol or 0)");
       AdaptiveOptions ao = opt.adaptive;
       ao.tol = opt.rtol;
+      ao.atol = opt.atol;
       ao.max_steps = opt.max_steps;
       if (std::holds_alternative<MpeDef>(def.build())) {
         auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <map>
 #include <mutex>
@@ -11,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include "nystrom/analysis/method_file.hpp"
 #include "nystrom/methods/blanes_moan2002.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/chin2010.hpp"
@@ -89,6 +89,15 @@ NYSTROM_DECL const std::vector<MethodDef>& catalog() {
 }
 
 /// Resolves a method specification (see the top of this file). Throws std::invalid_argument.
+namespace detail {
+NYSTROM_DECL std::atomic<MethodFileReader>& method_file_reader() {
+  static std::atomic<MethodFileReader> reader{nullptr};
+  return reader;
+}
+}  // namespace detail
+
+NYSTROM_DECL void set_method_file_reader(MethodFileReader reader) { detail::method_file_reader().store(reader); }
+
 NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
   if (spec.empty()) throw std::invalid_argument("empty method name");
   for (const auto& d : catalog()) {
@@ -149,8 +158,13 @@ NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
     if (ls.rfind(prefix, 0) == 0)
       return finalize(
           methods::suzuki_method(methods::parse_composition_order(spec.substr(prefix.size()), spec), base, ls));
-  if (ls.rfind("file:", 0) == 0)
-    return finalize(analysis::method_def_from_file(spec.substr(5)));  // analysis/method_file.hpp
+  if (ls.rfind("file:", 0) == 0) {
+    const MethodFileReader reader = detail::method_file_reader().load();
+    if (!reader)
+      throw std::invalid_argument(
+          "method files need the method-file reader (include nystrom/analysis/method_file.hpp)");
+    return finalize(reader(spec.substr(5)));
+  }
   if (ls.rfind("adjoint:", 0) == 0) {
     // Nested adjoints are peeled off in a loop (a recursive descent overflowed the stack at a few thousand
     // levels); the adjoint is an involution, so only the parity of the nesting changes the method.
