@@ -79,12 +79,14 @@ TEST(KeplerDrift, StumpffFunctionsMatchTheirClosedForms) {
     const LD s = std::sqrt(std::fabs(LD(x)));
     const LD c0 = x > 0 ? std::cos(s) : std::cosh(s);
     const LD c1 = x > 0 ? std::sin(s) / s : std::sinh(s) / s;
-    EXPECT_NEAR(static_cast<double>(c.c0), static_cast<double>(c0), 1e-15 * std::max(1.0, std::fabs(double(c0))));
-    EXPECT_NEAR(static_cast<double>(c.c1), static_cast<double>(c1), 1e-15 * std::max(1.0, std::fabs(double(c1))));
+    // the quadruple-argument identities amplify the rounding of the series about 2-fold per quartering
+    const double tol = 1e-15 * (1 + std::fabs(x));
+    EXPECT_NEAR(static_cast<double>(c.c0), static_cast<double>(c0), tol * std::max(1.0, std::fabs(double(c0))));
+    EXPECT_NEAR(static_cast<double>(c.c1), static_cast<double>(c1), tol * std::max(1.0, std::fabs(double(c1))));
     // x c2 = 1 - c0 and x c3 = 1 - c1 (checked where the differences do not cancel)
     if (std::fabs(x) > 0.5) {
-      EXPECT_NEAR(static_cast<double>(x * c.c2), static_cast<double>(1 - c0), 1e-14 * std::fabs(double(1 - c0)));
-      EXPECT_NEAR(static_cast<double>(x * c.c3), static_cast<double>(1 - c1), 1e-14 * std::fabs(double(1 - c1)));
+      EXPECT_NEAR(static_cast<double>(x * c.c2), static_cast<double>(1 - c0), tol * std::fabs(double(1 - c0)));
+      EXPECT_NEAR(static_cast<double>(x * c.c3), static_cast<double>(1 - c1), tol * std::fabs(double(1 - c1)));
     }
   }
   const Stumpff<double> z = stumpff(0.0);

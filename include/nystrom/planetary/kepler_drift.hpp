@@ -43,19 +43,27 @@ Stumpff<R> stumpff(R x) {
     x /= 4;
     ++quarterings;
   }
-  // c2 = sum_j (-x)^j / (2j+2)!, c3 = sum_j (-x)^j / (2j+3)!, summed from the smallest term
-  const R eps = std::numeric_limits<R>::epsilon();
-  int terms = 1;
-  R t = 1;
-  while (terms < 40) {  // |x| <= 0.1: the j-th term is below 0.1^j / (2j+2)!
-    t *= R(0.1) / R((2 * terms + 1) * (2 * terms + 2));
-    if (t < eps / 16) break;
-    ++terms;
-  }
-  R c2 = 0, c3 = 0;  // Horner: c2 = (1 - x (1 - x (...) / 30) / 12) / 2, c3 = (1 - x (1 - ...) / 20) / 6
-  for (int j = terms; j >= 0; --j) {
-    c2 = R(1) / R((2 * j + 1) * (2 * j + 2)) - x * c2 / R((2 * j + 1) * (2 * j + 2));
-    c3 = R(1) / R((2 * j + 2) * (2 * j + 3)) - x * c3 / R((2 * j + 2) * (2 * j + 3));
+  // c2 = sum_j (-x)^j / (2j+2)!, c3 = sum_j (-x)^j / (2j+3)! by Horner's rule, with the inverse factorials and
+  // the number of terms for |x| <= 0.1 at this precision computed once
+  struct Table {
+    std::array<R, 64> inv_fact{};
+    int terms = 0;
+    Table() {
+      inv_fact[0] = 1;
+      for (int k = 1; k < 64; ++k) inv_fact[k] = inv_fact[k - 1] / R(k);
+      const R eps = std::numeric_limits<R>::epsilon();
+      R bound = 1;
+      while (terms < 29 && bound * inv_fact[2 * terms + 2] > eps / 16) {
+        bound /= 10;
+        ++terms;
+      }
+    }
+  };
+  static const Table table;
+  R c2 = 0, c3 = 0;
+  for (int j = table.terms; j >= 0; --j) {
+    c2 = table.inv_fact[2 * j + 2] - x * c2;
+    c3 = table.inv_fact[2 * j + 3] - x * c3;
   }
   R c1 = 1 - x * c3;
   R c0 = 1 - x * c2;
