@@ -40,10 +40,9 @@ TEST(PlanetaryCli, JsonFieldsAndExtrapolationBeatsTheMap) {
   EXPECT_EQ(m8["force_evals"], 1826 * 10);
   EXPECT_EQ(wh["force_evals"], 1826);
   ASSERT_EQ(m8["jupiter_position"].size(), 3u);
-  // Jupiter stays near 5.2 AU from the Sun (which stays near the origin)
-  double r2 = 0;
-  for (int k = 0; k < 3; ++k) r2 += std::pow(m8["jupiter_position"][k].get<double>(), 2);
-  EXPECT_NEAR(std::sqrt(r2), 5.2, 0.3);
+  // the initial data are heliocentric, not barycentric: the frame drifts, so compare with the reference's Jupiter
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(m8["jupiter_position"][k].get<double>(), m8["reference"]["jupiter_position"][k].get<double>(), 1e-6);
   // the map conserves energy to its eps h^2 oscillation, angular momentum to rounding
   EXPECT_LT(wh["energy_error_max"].get<double>(), 1e-5);
   EXPECT_GT(wh["energy_error_max"].get<double>(), 1e-9);
