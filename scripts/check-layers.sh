@@ -12,7 +12,7 @@ layers=(
   "methods"
   "engines"
   "operators"
-  "solve quantum"
+  "solve quantum planetary"
   "analysis diagnostics"
   "experiments"
 )

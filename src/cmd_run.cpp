@@ -7,6 +7,7 @@
 #include "cli.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "runner.hpp"
+#include "runner_planetary.hpp"
 #include "runner_solve.hpp"
 #include "sweep.hpp"
 
@@ -17,12 +18,15 @@ struct Options {
   nystrom::cli::SolveRequest sreq;
   std::string method;
   bool json = false;
+  double years = 0;  // outer-solar-system
+  bool no_reference = false;
 };
 
 nystrom::cli::Registrar reg("run", "Integrate one problem with one method and report its errors", [](CLI::App& app) {
   auto o = std::make_shared<Options>();
   app.add_option("--problem", o->req.problem,
-                 "Problem: kepler (Chin eqs 35-36), harmonic, twobody (two equal masses), nbody (Plummer sphere)")
+                 "Problem: kepler (Chin eqs 35-36), harmonic, twobody (two equal masses), nbody (Plummer sphere), "
+                 "outer-solar-system (Hairer, GNI I.2.4; Wisdom-Holman maps WH, WH-M8, SABA3, ... or direct methods)")
       ->capture_default_str();
   app.add_option("--n", o->req.n, "nbody: number of particles of the Plummer sphere")
       ->capture_default_str()
@@ -31,7 +35,12 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--ic", o->req.ic_file, "nbody: particle file (m x y z vx vy vz per line)");
   app.add_option("--eps2", o->req.eps2, "nbody: softening squared (default (1/N)^2; twobody 0)")
       ->check(nystrom::cli::non_negative_check());
-  app.add_option("--h", o->req.h, "nbody: step size")->capture_default_str()->check(nystrom::cli::positive_check());
+  auto* h_option = app.add_option("--h", o->req.h, "nbody: step size; outer-solar-system: step in days (default 100)")
+                       ->capture_default_str()
+                       ->check(nystrom::cli::positive_check());
+  app.add_option("--years", o->years, "outer-solar-system: years of 365.25 days (default 1000)")
+      ->check(nystrom::cli::positive_check());
+  app.add_flag("--no-reference", o->no_reference, "outer-solar-system: skip the long double reference run");
   app.add_option("--steps", o->req.steps, "nbody: number of steps")
       ->capture_default_str()
       ->check(nystrom::cli::positive_check());
@@ -59,7 +68,23 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--restart", o->sreq.restart,
                  "Kepler: continue from a checkpoint file (the other options must match)");
   app.add_flag("--json", o->json, "Print one JSON object");
-  return [o]() {
+  return [o, h_option]() {
+    if (o->req.problem == "outer-solar-system") {
+      nystrom::cli::PlanetaryRequest p{.method = o->method,
+                                       .h = h_option->count() > 0 ? o->req.h : 100.0,
+                                       .years = o->years > 0 ? o->years : 1e3,
+                                       .precision = o->req.precision,
+                                       .tol = o->req.tol,
+                                       .reference = !o->no_reference};
+      const auto r = nystrom::cli::run_planetary(p);
+      if (o->json)
+        std::cout << r.dump(2) << "\n";
+      else
+        nystrom::cli::print_planetary(r);
+      return 0;
+    }
+    if (o->years > 0 || o->no_reference)
+      throw nystrom::cli::UsageError("--years and --no-reference apply to --problem outer-solar-system only");
     if (o->method.empty()) {
       if (o->sreq.restart.empty()) throw nystrom::cli::UsageError("--method is required");
       o->method = nystrom::cli::checkpoint_method(o->sreq.restart);

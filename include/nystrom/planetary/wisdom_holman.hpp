@@ -1,0 +1,203 @@
+// Wisdom-Holman maps: the splitting H = H_Kepler + H_interaction of a planetary system in Jacobi coordinates
+// as operator flows (operators/flows.hpp), so that every real splitting and multi-product method of the
+// catalog runs over them.
+//
+// J. Wisdom and M. Holman, "Symplectic maps for the N-body problem", AJ 102 (1991) 1528:
+//   H_Kepler      = sum_{i>=1} m'_i (|v'_i|^2 / 2 - mu_i / r'_i),   mu_i = G m_0 eta_i / eta_{i-1},
+//   H_interaction = sum_{i>=1} G m_0 m_i (1 / r'_i - 1 / r_0i) - sum_{1<=i<j} G m_i m_j / r_ij,
+// (system.hpp for the Jacobi coordinates); the centre of mass x'_0 moves freely with H_Kepler.
+// H_interaction depends on positions only, so its flow is a kick of the Jacobi velocities:
+//   v'_i += dt (a'_i + mu_i x'_i / r'_i^3),
+// where a'_i are the Jacobi components of the Newtonian accelerations (the Jacobi map applied to the inertial
+// accelerations: it is the gradient in Jacobi coordinates divided by m'_i, since the kinetic energy is
+// diagonal there) and the second term removes the Kepler part. This is the construction of WHFast (Rein &
+// Tamayo, MNRAS 452 (2015) 376). Flow A is the Kepler drift (kepler_drift.hpp) of every Jacobi coordinate,
+// flow B this kick. The pair satisfies [B,[B,[A,B]]] = 0 (B is a function of positions, A quadratic in the
+// velocities), so methods built for q'' = a(q) keep their order.
+//
+// Methods (resolve_wh_method):
+//   WH                the map itself: Kepler drift h/2, kick h, Kepler drift h/2 (the catalog's PV scheme);
+//   WH-<catalog name> any real splitting or multi-product method of the catalog over these flows, e.g. WH-M8 =
+//                     Chin's multi-product expansion of order 8 over the WH map (the natural sequence 1..4),
+//                     WH-KL8 = Kahan-Li's composition of WH maps, WH-mpe:1,2,3,4,5 (any sequence);
+//   SABA1..4, SBAB1..4 Laskar & Robutel's maps (methods/laskar_robutel2001.hpp).
+// Complex coefficients are refused: a Kepler drift over a complex time has no meaning for the orbits.
+//
+// Heliocentric "democratic" coordinates (Duncan, Levison & Lee, AJ 116 (1998) 2067) need a third flow (the
+// Sun's momentum drift) and are not offered; the Jacobi splitting is the one of Wisdom & Holman and WHFast.
+#pragma once
+
+#include <algorithm>
+#include <complex>
+#include <cstddef>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nystrom/core/scalar.hpp"
+#include "nystrom/methods/laskar_robutel2001.hpp"
+#include "nystrom/operators/flow_methods.hpp"
+#include "nystrom/planetary/kepler_drift.hpp"
+#include "nystrom/planetary/system.hpp"
+
+namespace nystrom::planetary {
+
+/// The Kepler drifts (A) and interaction kicks (B) of a planetary system over its flat Jacobi state.
+template <class R>
+class JacobiFlows {
+ public:
+  using state_type = std::vector<R>;
+  using real_type = R;
+
+  JacobiFlows(R G, std::vector<R> mass) : G_(G), mass_(std::move(mass)), mu_(jacobi_kepler_mu(G_, mass_)) {}
+
+  std::size_t bodies() const { return mass_.size(); }
+  const std::vector<R>& masses() const { return mass_; }
+  R G() const { return G_; }
+  long kepler_drifts() const { return drifts_; }  // applications of flow A
+  long kicks() const { return kicks_; }           // applications of flow B (one force evaluation each)
+
+  void apply_a(state_type& s, std::complex<R> z) {
+    if (z.imag() != 0)
+      throw std::invalid_argument("a Kepler drift takes a real time: methods with complex coefficients do not apply");
+    const R dt = z.real();
+    const std::size_t n = mass_.size();
+    R* x = s.data();
+    R* v = s.data() + 3 * n;
+    for (int k = 0; k < 3; ++k) x[k] += dt * v[k];  // the centre of mass
+    for (std::size_t i = 1; i < n; ++i) {
+      Vec3<R> xi{x[3 * i], x[3 * i + 1], x[3 * i + 2]}, vi{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+      kepler_drift(mu_[i], dt, xi, vi);
+      for (int k = 0; k < 3; ++k) {
+        x[3 * i + k] = xi[k];
+        v[3 * i + k] = vi[k];
+      }
+    }
+    ++drifts_;
+  }
+
+  void apply_b(state_type& s, std::complex<R> z) {
+    if (z.imag() != 0)
+      throw std::invalid_argument(
+          "an interaction kick takes a real time: methods with complex coefficients do not apply");
+    using std::sqrt;
+    const R dt = z.real();
+    const std::size_t n = mass_.size();
+    R* x = s.data();
+    R* v = s.data() + 3 * n;
+    pos_.resize(n);
+    detail::jacobi_to_inertial<R>(
+        mass_, n,
+        [&](std::size_t i) {
+          return i == 0 ? Vec3<R>{0, 0, 0} : Vec3<R>{x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+        },
+        [&](std::size_t i, const Vec3<R>& xi) { pos_[i] = xi; });
+    accelerations(G_, mass_, pos_, acc_);
+    detail::inertial_to_jacobi<R>(
+        mass_, n, [&](std::size_t i) { return acc_[i]; },
+        [&](std::size_t i, const Vec3<R>& a) {
+          if (i == 0) return;  // the centre of mass is not accelerated
+          const R xx = x[3 * i], xy = x[3 * i + 1], xz = x[3 * i + 2];
+          const R r2 = xx * xx + xy * xy + xz * xz;
+          const R k = mu_[i] / (r2 * sqrt(r2));
+          v[3 * i] += dt * (a[0] + k * xx);
+          v[3 * i + 1] += dt * (a[1] + k * xy);
+          v[3 * i + 2] += dt * (a[2] + k * xz);
+        });
+    ++kicks_;
+  }
+
+  void assign(state_type& d, const state_type& s) { d = s; }
+  void scale(state_type& s, R r) {
+    for (R& a : s) a *= r;
+  }
+  void axpy(state_type& d, R r, const state_type& s) {
+    for (std::size_t i = 0; i < d.size(); ++i) d[i] += r * s[i];
+  }
+
+ private:
+  R G_;
+  std::vector<R> mass_, mu_;
+  std::vector<Vec3<R>> pos_, acc_;  // scratch of the kick
+  long drifts_ = 0, kicks_ = 0;
+};
+
+/// Resolves a Wisdom-Holman method name (see the top of this file) with coefficients for a working type of
+/// `bits` bits. Throws std::invalid_argument for unknown names and for methods that do not apply.
+inline operators::FlowMethod resolve_wh_method(const std::string& spec, long bits, const std::string& type_name) {
+  if (spec == "WH")
+    return {MethodInfo{.name = "WH",
+                       .family = "splitting",
+                       .order = 2,
+                       .symmetric = true,
+                       .symplectic = true,
+                       .source = "Wisdom & Holman, AJ 102 (1991) 1528",
+                       .description = "Wisdom-Holman map: Kepler drift h/2, interaction kick h, Kepler drift h/2",
+                       .aliases = {}},
+            position_verlet_scheme()};
+  for (const MethodDef& def : methods::laskar_robutel2001())
+    if (def.info.name == spec)
+      return {def.info, std::get<SplittingScheme<bigcomplex>>(method_data_for(def, bits, type_name))};
+  if (spec.rfind("WH-", 0) == 0 && spec.size() > 3) {
+    operators::FlowMethod m =
+        operators::resolve_flow_method(spec.substr(3), operators::OperatorStructure::rkn, bits, type_name);
+    if (m.info.complex)
+      throw std::invalid_argument("'" + spec +
+                                  "' has complex coefficients: a Kepler drift over a complex time does not apply");
+    m.info.description = m.info.description + ", over the Wisdom-Holman splitting";
+    m.info.name = spec;
+    return m;
+  }
+  throw std::invalid_argument("unknown planetary method '" + spec +
+                              "': use WH, WH-<catalog method> (e.g. WH-M8), SABA1..SABA4 or SBAB1..SBAB4");
+}
+
+/// What a run observes: called before the first step and after every `every` steps (and after the last).
+template <class R>
+struct PropagateOptions {
+  long every = 0;  // 0: no observation
+  std::function<void(long step, const std::vector<R>& jacobi)> observer;
+};
+
+template <class R>
+struct PropagateResult {
+  PlanetarySystem<R> system;  // the final state, in the frame of the initial one
+  MethodInfo method;
+  long kepler_drifts = 0, kicks = 0;
+};
+
+/// Advances a planetary system by `steps` steps of size h with a Wisdom-Holman method.
+template <class R>
+PropagateResult<R> propagate(const PlanetarySystem<R>& sys, const std::string& method, R h, long steps,
+                             const PropagateOptions<R>& opt = {}) {
+  sys.validate();
+  if (!(h > 0) || !std::isfinite(static_cast<double>(h)))
+    throw std::invalid_argument("the step must be positive and finite");
+  if (steps < 0) throw std::invalid_argument("the number of steps must not be negative");
+  const operators::FlowMethod fm = resolve_wh_method(method, scalar_traits<R>::bits(), scalar_traits<R>::name());
+  JacobiFlows<R> flows(sys.G, sys.mass);
+  operators::FlowIntegrator<JacobiFlows<R>> integ(fm);
+  std::vector<R> s = to_jacobi(sys);
+  if (opt.every > 0 && opt.observer) {
+    opt.observer(0, s);
+    for (long done = 0; done < steps;) {
+      const long chunk = std::min(opt.every, steps - done);
+      integ.integrate(flows, s, h, chunk);
+      done += chunk;
+      opt.observer(done, s);
+    }
+  } else {
+    integ.integrate(flows, s, h, steps);
+  }
+  PropagateResult<R> r;
+  r.system = sys;
+  from_jacobi(sys.mass, s, r.system.x, r.system.v);
+  r.method = fm.info;
+  r.kepler_drifts = flows.kepler_drifts();
+  r.kicks = flows.kicks();
+  return r;
+}
+
+}  // namespace nystrom::planetary

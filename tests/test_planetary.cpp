@@ -1,0 +1,375 @@
+// Planetary systems: the universal-variable Kepler drift against the analytic elliptic, parabolic and
+// hyperbolic solutions; Jacobi coordinates; the Wisdom-Holman maps over them: the order of every map in the
+// step, the eps h^2 structure of the errors (Laskar & Robutel 2001), bounded energy on the outer solar system.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "nystrom/planetary/kepler_drift.hpp"
+#include "nystrom/planetary/system.hpp"
+#include "nystrom/planetary/wisdom_holman.hpp"
+
+using namespace nystrom::planetary;
+using LD = long double;
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+const LD kPi = 3.14159265358979323846264338327950288L;
+
+template <class R>
+R norm3(const Vec3<R>& a) {
+  using std::sqrt;
+  return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+}
+
+template <class A, class B>
+double distance(const Vec3<A>& a, const Vec3<B>& b) {
+  LD s = 0;
+  for (int k = 0; k < 3; ++k) s += (LD(a[k]) - LD(b[k])) * (LD(a[k]) - LD(b[k]));
+  return static_cast<double>(std::sqrt(s));
+}
+
+/// The planar elliptic orbit through (x, v) (z = 0) at time t, from its elements, in long double: a from the
+/// energy, the eccentricity vector, the mean anomaly from the eccentric one, Kepler's equation by Newton.
+void elliptic_analytic(LD mu, const Vec3<LD>& x0, const Vec3<LD>& v0, LD t, Vec3<LD>& x, Vec3<LD>& v) {
+  const LD r = norm3(x0), v2 = v0[0] * v0[0] + v0[1] * v0[1];
+  const LD a = 1 / (2 / r - v2 / mu);
+  const LD rv = x0[0] * v0[0] + x0[1] * v0[1];
+  const LD ex = ((v2 - mu / r) * x0[0] - rv * v0[0]) / mu, ey = ((v2 - mu / r) * x0[1] - rv * v0[1]) / mu;
+  const LD e = std::sqrt(ex * ex + ey * ey), w = std::atan2(ey, ex);
+  const LD sgn = x0[0] * v0[1] - x0[1] * v0[0] > 0 ? 1 : -1;
+  const LD E0 = std::atan2(rv / std::sqrt(mu * a), 1 - r / a);  // e sin E, e cos E
+  const LD n = std::sqrt(mu / (a * a * a));
+  LD M = std::fmod(E0 - e * std::sin(E0) + n * t, 2 * kPi);
+  LD E = M + e * std::sin(M);
+  for (int i = 0; i < 60; ++i) E -= (E - e * std::sin(E) - M) / (1 - e * std::cos(E));
+  const LD b = a * std::sqrt(1 - e * e), edot = n / (1 - e * std::cos(E));
+  const LD X = a * (std::cos(E) - e), Y = sgn * b * std::sin(E);
+  const LD VX = -a * std::sin(E) * edot, VY = sgn * b * std::cos(E) * edot;
+  x = {X * std::cos(w) - Y * std::sin(w), X * std::sin(w) + Y * std::cos(w), 0};
+  v = {VX * std::cos(w) - VY * std::sin(w), VX * std::sin(w) + VY * std::cos(w), 0};
+}
+
+/// A planar orbit of eccentricity e and pericentre distance q (mu = 1), at pericentre.
+Vec3<double> pericentre_velocity(double e, double q) { return {0, std::sqrt((1 + e) / q), 0}; }
+
+template <class R>
+R kepler_energy(R mu, const Vec3<R>& x, const Vec3<R>& v) {
+  return (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / 2 - mu / norm3(x);
+}
+
+template <class R>
+Vec3<R> cross(const Vec3<R>& a, const Vec3<R>& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+}  // namespace
+
+// ---- the Kepler drift ---------------------------------------------------------------------------------------
+
+TEST(KeplerDrift, StumpffFunctionsMatchTheirClosedForms) {
+  for (double x : {-50.0, -3.0, -0.05, 1e-12, 0.05, 0.7, 3.0, 20.0, 39.0}) {
+    const Stumpff<LD> c = stumpff<LD>(x);
+    const LD s = std::sqrt(std::fabs(LD(x)));
+    const LD c0 = x > 0 ? std::cos(s) : std::cosh(s);
+    const LD c1 = x > 0 ? std::sin(s) / s : std::sinh(s) / s;
+    // the quadruple-argument identities amplify the rounding of the series about 2-fold per quartering
+    const double tol = 1e-15 * (1 + std::fabs(x));
+    EXPECT_NEAR(static_cast<double>(c.c0), static_cast<double>(c0), tol * std::max(1.0, std::fabs(double(c0))));
+    EXPECT_NEAR(static_cast<double>(c.c1), static_cast<double>(c1), tol * std::max(1.0, std::fabs(double(c1))));
+    // x c2 = 1 - c0 and x c3 = 1 - c1 (checked where the differences do not cancel)
+    if (std::fabs(x) > 0.5) {
+      EXPECT_NEAR(static_cast<double>(x * c.c2), static_cast<double>(1 - c0), tol * std::fabs(double(1 - c0)));
+      EXPECT_NEAR(static_cast<double>(x * c.c3), static_cast<double>(1 - c1), tol * std::fabs(double(1 - c1)));
+    }
+  }
+  const Stumpff<double> z = stumpff(0.0);
+  EXPECT_EQ(z.c0, 1.0);
+  EXPECT_EQ(z.c1, 1.0);
+  EXPECT_EQ(z.c2, 0.5);
+  EXPECT_DOUBLE_EQ(z.c3, 1.0 / 6.0);
+}
+
+// One drift across a million orbits: the only error is the rounding of the mean motion times the time,
+// eps n t, which the analytic formula evaluated in double has too.
+TEST(KeplerDrift, MatchesTheEllipticSolutionOverAMillionOrbits) {
+  for (double e : {0.0167, 0.5, 0.9, 0.99}) {
+    const Vec3<double> x0{1 - e, 0, 0}, v0 = pericentre_velocity(e, 1 - e);
+    const double orbits = 1e6 + 0.3;  // a = 1, period 2 pi
+    const double t = 2 * static_cast<double>(kPi) * orbits;
+    Vec3<double> x = x0, v = v0;
+    kepler_drift(1.0, t, x, v);
+    Vec3<LD> xr, vr;
+    elliptic_analytic(1, {x0[0], x0[1], 0}, {v0[0], v0[1], 0}, t, xr, vr);
+    const double bound = 8 * kEps * (1 + 2 * static_cast<double>(kPi) * orbits) * (1 + e) / (1 - e);
+    EXPECT_LT(distance(x, xr), bound) << "e = " << e;
+    EXPECT_LT(distance(v, vr), bound * std::sqrt((1 + e) / (1 - e))) << "e = " << e;
+  }
+}
+
+// Many short drifts (a Wisdom-Holman run): rounding accumulates like a random walk, not secularly.
+TEST(KeplerDrift, ManyShortDriftsStayOnTheEllipse) {
+  for (double e : {0.1, 0.9}) {
+    const Vec3<double> x0{1 - e, 0, 0}, v0 = pericentre_velocity(e, 1 - e);
+    const long orbits = 200, per_orbit = 100;
+    const double h = 2 * static_cast<double>(kPi) / per_orbit + 1e-3;  // not commensurate with the period
+    Vec3<double> x = x0, v = v0;
+    for (long i = 0; i < orbits * per_orbit; ++i) kepler_drift(1.0, h, x, v);
+    Vec3<LD> xr, vr;
+    elliptic_analytic(1, {x0[0], x0[1], 0}, {v0[0], v0[1], 0}, LD(h) * (orbits * per_orbit), xr, vr);
+    // Brouwer's law: the energy (so the mean motion) random-walks by eps per step, the phase error grows as
+    // eps n t sqrt(steps); eccentric orbits amplify it by up to 1 / (1 - e)
+    const double steps = static_cast<double>(orbits * per_orbit);
+    const double bound = 2 * kEps * 2 * static_cast<double>(kPi) * orbits * std::sqrt(steps) / (1 - e);
+    EXPECT_LT(distance(x, xr), bound) << "e = " << e;
+    EXPECT_NEAR(kepler_energy(1.0, x, v), -0.5, 50 * kEps * orbits) << "e = " << e;
+  }
+}
+
+TEST(KeplerDrift, CompositionIsTheDriftOfTheSumAndTimeReversible) {
+  for (double e : {0.3, 0.95, 1.0, 2.5}) {  // elliptic, parabolic, hyperbolic
+    const Vec3<double> x0{1, 0.1, -0.05}, vq = pericentre_velocity(e, 1.0);
+    const Vec3<double> v0{0.02, vq[1], 0.1};
+    for (double h1 : {0.37, 5.0, -2.0}) {
+      const double h2 = 1.91;
+      Vec3<double> xa = x0, va = v0, xb = x0, vb = v0;
+      kepler_drift(1.0, h1, xa, va);
+      kepler_drift(1.0, h2, xa, va);
+      kepler_drift(1.0, h1 + h2, xb, vb);
+      const double scale = norm3(xb) + 1;
+      EXPECT_LT(distance(xa, xb), 200 * kEps * scale) << "e = " << e << " h1 = " << h1;
+      EXPECT_LT(distance(va, vb), 200 * kEps * (norm3(vb) + 1)) << "e = " << e << " h1 = " << h1;
+      kepler_drift(1.0, -(h1 + h2), xb, vb);  // back to the start
+      EXPECT_LT(distance(xb, x0), 200 * kEps * scale) << "e = " << e << " h1 = " << h1;
+    }
+  }
+}
+
+// Barker's equation: a parabola with pericentre q reaches D = tan(nu / 2) at t = sqrt(2 q^3 / mu) (D + D^3 / 3).
+TEST(KeplerDrift, MatchesTheParabolicSolution) {
+  const double q = 0.5;  // v = 2: the state is exactly parabolic in double
+  const Vec3<double> x0{q, 0, 0}, v0{0, std::sqrt(2 / q), 0};
+  for (double t : {0.01, 1.0, 30.0, 1e4}) {
+    Vec3<double> x = x0, v = v0;
+    kepler_drift(1.0, t, x, v);
+    const LD tau = t / std::sqrt(LD(2) * q * q * q);
+    const LD w = 1.5L * tau, root = std::sqrt(w * w + 1);
+    const LD D = std::cbrt(w + root) - std::cbrt(root - w);
+    const Vec3<LD> xr{q * (1 - D * D), 2 * q * D, 0};
+    EXPECT_LT(distance(x, xr), 20 * kEps * norm3(xr)) << "t = " << t;
+  }
+}
+
+// Nearly parabolic orbits (e = 1 -+ 1e-10) lose nothing: the double drift agrees with the long double one to
+// rounding, and energy and angular momentum are kept to rounding.
+TEST(KeplerDrift, NearlyParabolicOrbitsLoseNoAccuracy) {
+  for (double e : {1 - 1e-10, 1 + 1e-10, 1 - 1e-6, 1.5, 10.0}) {
+    const double q = 0.5;
+    const Vec3<double> x0{q, 0, 0}, v0 = pericentre_velocity(e, q);
+    for (double t : {0.1, 10.0, 1e3}) {
+      Vec3<double> x = x0, v = v0;
+      kepler_drift(1.0, t, x, v);
+      Vec3<LD> xl{x0[0], x0[1], x0[2]}, vl{v0[0], v0[1], v0[2]};
+      kepler_drift<LD>(1, t, xl, vl);
+      EXPECT_LT(distance(x, xl), 50 * kEps * norm3(xl)) << "e = " << e << " t = " << t;
+      EXPECT_LT(distance(v, vl), 50 * kEps * (norm3(vl) + 1)) << "e = " << e << " t = " << t;
+      // to the rounding of the terms of each quantity
+      const double e0 = kepler_energy(1.0, x0, v0), scale = norm3(v) * norm3(v) + 1 / norm3(x);
+      EXPECT_NEAR(kepler_energy(1.0, x, v), e0, 20 * kEps * scale) << "e = " << e << " t = " << t;
+      EXPECT_NEAR(cross(x, v)[2], cross(x0, v0)[2], 20 * kEps * norm3(x) * norm3(v)) << "e = " << e << " t = " << t;
+    }
+  }
+}
+
+TEST(KeplerDrift, LongDoubleMatchesTheEllipticSolutionToItsRounding) {
+  const LD e = 0.6L, epsl = std::numeric_limits<LD>::epsilon();
+  const Vec3<LD> x0{1 - e, 0, 0}, v0{0, std::sqrt((1 + e) / (1 - e)), 0};
+  const LD t = 2 * kPi * 1000.25L;
+  Vec3<LD> x = x0, v = v0, xr, vr;
+  kepler_drift<LD>(1, t, x, v);
+  elliptic_analytic(1, x0, v0, t, xr, vr);
+  EXPECT_LT(distance(x, xr), static_cast<double>(16 * epsl * 2 * kPi * 1000 * 4));
+}
+
+TEST(KeplerDrift, RefusesACollisionOrbit) {
+  Vec3<double> x{0, 0, 0}, v{1, 0, 0};
+  EXPECT_THROW(kepler_drift(1.0, 1.0, x, v), std::invalid_argument);
+}
+
+// ---- Jacobi coordinates ---------------------------------------------------------------------------------------
+
+TEST(Jacobi, RoundTripAndDiagonalKineticEnergy) {
+  const PlanetarySystem<double> sys = outer_solar_system<double>();
+  const std::vector<double> s = to_jacobi(sys);
+  std::vector<Vec3<double>> x, v;
+  from_jacobi(sys.mass, s, x, v);
+  for (std::size_t i = 0; i < sys.size(); ++i) {
+    EXPECT_LT(distance(x[i], sys.x[i]), 1e-14 * 40);
+    EXPECT_LT(distance(v[i], sys.v[i]), 1e-16 * 40);
+  }
+  // sum m v^2 = sum m' v'^2 with m'_0 the total mass and m'_i = m_i eta_{i-1} / eta_i
+  const std::size_t n = sys.size();
+  double inertial = 0, jacobi = 0, eta = sys.mass[0];
+  for (std::size_t i = 0; i < n; ++i) inertial += sys.mass[i] * (norm3(sys.v[i]) * norm3(sys.v[i]));
+  for (std::size_t i = 1; i < n; ++i) {
+    const double next = eta + sys.mass[i];
+    const Vec3<double> vj{s[3 * n + 3 * i], s[3 * n + 3 * i + 1], s[3 * n + 3 * i + 2]};
+    jacobi += sys.mass[i] * eta / next * norm3(vj) * norm3(vj);
+    eta = next;
+  }
+  const Vec3<double> vc{s[3 * n], s[3 * n + 1], s[3 * n + 2]};
+  jacobi += eta * norm3(vc) * norm3(vc);
+  EXPECT_NEAR(jacobi, inertial, 1e-14 * inertial);
+}
+
+// ---- Wisdom-Holman maps ---------------------------------------------------------------------------------------
+
+namespace {
+
+/// A star of mass 1 and two planets of masses eps and eps / 2 on nearly circular (e about 0.1), inclined,
+/// non-resonant orbits (G = 1, inner period about 2 pi).
+template <class R>
+PlanetarySystem<R> two_planets(R eps) {
+  PlanetarySystem<R> s;
+  s.G = 1;
+  s.mass = {1, eps, eps / 2};
+  s.x = {Vec3<R>{0, 0, 0}, {1, 0, 0}, {0, R(1.7), R(0.05)}};
+  s.v = {Vec3<R>{0, 0, 0}, {0, R(1.05), R(0.02)}, {R(-0.95) / std::sqrt(R(1.7)), 0, R(0.01)}};
+  return s;
+}
+
+/// Positions of the planets after time T with a step T / n.
+template <class R>
+std::vector<Vec3<R>> planets_at(const PlanetarySystem<R>& s, const std::string& method, R T, long n) {
+  return propagate(s, method, T / static_cast<R>(n), n).system.x;
+}
+
+template <class R>
+double max_distance(const std::vector<Vec3<R>>& a, const std::vector<Vec3<R>>& b) {
+  double d = 0;
+  for (std::size_t i = 1; i < a.size(); ++i) d = std::max(d, distance(a[i], b[i]));
+  return d;
+}
+
+/// Observed order from the differences of runs with n, 2n, 4n steps.
+template <class R>
+double observed_order(const PlanetarySystem<R>& s, const std::string& method, R T, long n) {
+  const auto a = planets_at(s, method, T, n), b = planets_at(s, method, T, 2 * n), c = planets_at(s, method, T, 4 * n);
+  return std::log2(max_distance(a, b) / max_distance(b, c));
+}
+
+// 17 time units: 2.7 inner orbits, so that no step of the tests is a simple fraction of the period (Wisdom-Holman
+// maps have step-size resonances there).
+constexpr double kT = 17.0;
+
+}  // namespace
+
+namespace {
+
+/// The largest relative energy error over a run of n steps to time T (every step observed).
+template <class R>
+double energy_error_max(const PlanetarySystem<R>& s, const std::string& method, R T, long n) {
+  const R e0 = energy(s.G, s.mass, s.x, s.v);
+  double m = 0;
+  std::vector<Vec3<R>> x, v;
+  PropagateOptions<R> opt;
+  opt.every = 1;
+  opt.observer = [&](long, const std::vector<R>& st) {
+    from_jacobi(s.mass, st, x, v);
+    m = std::max(m, std::fabs(static_cast<double>(energy(s.G, s.mass, x, v) / e0 - 1)));
+  };
+  (void)propagate(s, method, T / static_cast<R>(n), n, opt);
+  return m;
+}
+
+double energy_order(double eps, const std::string& method, long n) {
+  const PlanetarySystem<LD> s = two_planets<LD>(eps);
+  return std::log2(energy_error_max<LD>(s, method, kT, n) / energy_error_max<LD>(s, method, kT, 2 * n));
+}
+
+}  // namespace
+
+// The energy error of a map is the size of its modified Hamiltonian's correction: for H = A + eps B, the
+// Wisdom-Holman map's is eps h^2; SABA_n's and SBAB_n's eps h^{2n} + eps^2 h^2 (Laskar & Robutel 2001), so
+// their slope is 2n for small eps and 2 once eps^2 h^2 dominates; the multi-product expansions over the map
+// remove every h^2 ... h^{p-2} term, both orders in eps. Long double keeps the rounding floor below the
+// smallest errors measured; the steps are in the asymptotic range (at least 60 per inner orbit for p >= 6).
+TEST(WisdomHolman, OrderOfTheEnergyErrorInTheStepAndThePerturbation) {
+  struct Case {
+    std::string method;
+    double eps;
+    long n;
+    double order;
+  };
+  for (const Case& c : std::vector<Case>{{"WH", 1e-3, 64, 2},
+                                         {"SABA2", 1e-3, 64, 2},  // eps^2 h^2 dominates
+                                         {"SBAB2", 1e-3, 64, 2},
+                                         {"SABA2", 1e-7, 64, 4},  // eps h^4 dominates
+                                         {"SBAB2", 1e-7, 64, 4},
+                                         {"WH-M4", 1e-3, 64, 4},
+                                         {"WH-FR", 1e-3, 64, 4},
+                                         {"WH-M6", 1e-3, 128, 6},
+                                         {"WH-M8", 1e-5, 64, 8},
+                                         {"WH-mpe:1,2,3,4,6", 1e-5, 16, 10}})
+    EXPECT_NEAR(energy_order(c.eps, c.method, c.n), c.order, 0.35) << c.method << " eps = " << c.eps;
+}
+
+// The Wisdom-Holman energy error is linear in the perturbation (eps h^2), and higher SABA_n gain orders at
+// small eps: at eps = 1e-7 and 64 steps each n lowers the error.
+TEST(WisdomHolman, EnergyErrorIsLinearInThePerturbation) {
+  const double small = energy_error_max<LD>(two_planets<LD>(1e-7), "WH", kT, 128);
+  const double large = energy_error_max<LD>(two_planets<LD>(1e-5), "WH", kT, 128);
+  EXPECT_NEAR(large / small, 100.0, 5.0);
+  const PlanetarySystem<LD> s = two_planets<LD>(1e-7);
+  double previous = energy_error_max<LD>(s, "SABA1", kT, 64);
+  for (const char* m : {"SABA2", "SABA3", "SABA4"}) {
+    const double e = energy_error_max<LD>(s, m, kT, 64);
+    EXPECT_LT(e, previous / 4) << m;
+    previous = e;
+  }
+}
+
+// Positions in double: the Wisdom-Holman map and its fourth-order extrapolation converge at their orders.
+TEST(WisdomHolman, ObservedOrderOfThePositions) {
+  const PlanetarySystem<double> s = two_planets<double>(1e-3);
+  EXPECT_NEAR(observed_order<double>(s, "WH", kT, 64), 2, 0.35);
+  EXPECT_NEAR(observed_order<double>(s, "WH-M4", kT, 64), 4, 0.35);
+}
+
+// The energy error of WH on the outer solar system over 10^4 years oscillates without drift.
+TEST(WisdomHolman, BoundedEnergyOnTheOuterSolarSystem) {
+  const PlanetarySystem<double> sys = outer_solar_system<double>();
+  const double e0 = energy(sys.G, sys.mass, sys.x, sys.v);
+  const double h = 100, years = 1e4;
+  const long steps = static_cast<long>(years * 365.25 / h);
+  double first = 0, second = 0;
+  std::vector<Vec3<double>> x, v;
+  PropagateOptions<double> opt;
+  opt.every = 10;
+  opt.observer = [&](long step, const std::vector<double>& s) {
+    from_jacobi(sys.mass, s, x, v);
+    const double de = std::fabs(energy(sys.G, sys.mass, x, v) / e0 - 1);
+    (step <= steps / 2 ? first : second) = std::max(step <= steps / 2 ? first : second, de);
+  };
+  (void)propagate(sys, "WH", h, steps, opt);
+  EXPECT_GT(first, 1e-9);          // WH at 100 days: an eps h^2 oscillation well above rounding ...
+  EXPECT_LT(first, 1e-5);          // ... and small
+  EXPECT_LT(second, 1.5 * first);  // no secular growth
+}
+
+TEST(WisdomHolman, RefusesComplexAndUnknownMethods) {
+  const PlanetarySystem<double> s = two_planets(1e-3);
+  EXPECT_THROW((void)propagate(s, "WH-BC1", 0.1, 10), std::invalid_argument);
+  EXPECT_THROW((void)propagate(s, "nonsense", 0.1, 10), std::invalid_argument);
+  EXPECT_THROW((void)propagate(s, "WH-DP12-adaptive", 0.1, 10), std::invalid_argument);
+  EXPECT_THROW((void)propagate(s, "WH", -0.1, 10), std::invalid_argument);
+  PlanetarySystem<double> bad = s;
+  bad.mass[1] = -1;
+  EXPECT_THROW((void)propagate(bad, "WH", 0.1, 10), std::invalid_argument);
+}
