@@ -37,3 +37,28 @@ if(FFTW3_INCLUDE_DIR AND FFTW3_LIBRARY AND FFTW3L_LIBRARY AND NOT TARGET nystrom
   target_link_libraries(nystrom_fftw INTERFACE ${FFTW3_LIBRARY} ${FFTW3L_LIBRARY})
   set(NYSTROM_HAVE_FFTW ON)
 endif()
+
+# MPI for grids distributed over ranks (include/nystrom/quantum/fftw_mpi.hpp, `mpirun -np N nystrom quantum`):
+# FFTW's MPI transforms (fftw3_mpi, fftw3l_mpi) and MPI's C interface. NYSTROM_MPI defaults to ON when both are
+# found; without it the tool runs on one process. Library users who do not include fftw_mpi.hpp never need MPI.
+if(TARGET nystrom_fftw AND NOT TARGET nystrom_fftw_mpi)
+  set(MPI_CXX_SKIP_MPICXX ON)
+  find_package(MPI COMPONENTS CXX QUIET)
+  find_library(FFTW3_MPI_LIBRARY fftw3_mpi)
+  find_library(FFTW3L_MPI_LIBRARY fftw3l_mpi)
+  set(nystrom_mpi_found OFF)
+  if(MPI_CXX_FOUND AND FFTW3_MPI_LIBRARY AND FFTW3L_MPI_LIBRARY)
+    set(nystrom_mpi_found ON)
+  endif()
+  option(NYSTROM_MPI "Distributed grids for the quantum solver (MPI + FFTW's MPI transforms)" ${nystrom_mpi_found})
+  if(NYSTROM_MPI)
+    if(NOT nystrom_mpi_found)
+      message(FATAL_ERROR "NYSTROM_MPI needs MPI and fftw3_mpi, fftw3l_mpi (libopenmpi-dev, libfftw3-mpi-dev)")
+    endif()
+    add_library(nystrom_fftw_mpi INTERFACE)
+    add_library(nystrom::fftw_mpi ALIAS nystrom_fftw_mpi)
+    target_compile_definitions(nystrom_fftw_mpi INTERFACE NYSTROM_HAVE_MPI)
+    target_link_libraries(nystrom_fftw_mpi INTERFACE ${FFTW3_MPI_LIBRARY} ${FFTW3L_MPI_LIBRARY} nystrom_fftw
+                                                     MPI::MPI_CXX)
+  endif()
+endif()

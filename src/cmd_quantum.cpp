@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@
 
 #include "cli.hpp"
 #include "nystrom/quantum/solve.hpp"
+#ifdef NYSTROM_HAVE_MPI
+#include "nystrom/quantum/fftw_mpi.hpp"
+#endif
 
 extern char** environ;
 
@@ -30,6 +34,7 @@ using namespace nystrom::quantum;
 
 struct Options {
   std::string potential = "harmonic";
+  std::string potential_file;
   int dims = 1;
   int grid = 256;
   std::string box = "20";
@@ -41,8 +46,73 @@ struct Options {
   std::string precision = "double";
   int threads = 1;
   bool json = false;
+  bool autocorrelation = false;
+  int states = 1;
   std::string plot;
 };
+
+/// MPI for one run when the tool was started by an MPI launcher (OpenMPI's mpirun sets OMPI_COMM_WORLD_SIZE,
+/// MPICH's PMI_SIZE, PMIx launchers PMIX_RANK); otherwise none, so a plain run neither needs nor starts MPI.
+/// Ranks other than 0 write nothing: every rank computes the same observables of the whole grid.
+class MpiSession {
+ public:
+  MpiSession() {
+#ifdef NYSTROM_HAVE_MPI
+    if (!std::getenv("OMPI_COMM_WORLD_SIZE") && !std::getenv("PMI_SIZE") && !std::getenv("PMIX_RANK")) return;
+    MPI_Init(nullptr, nullptr);
+    active_ = true;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    if (rank_ != 0) {
+      const int null = ::open("/dev/null", O_WRONLY);
+      if (null >= 0) {
+        ::dup2(null, STDOUT_FILENO);
+        ::dup2(null, STDERR_FILENO);
+        ::close(null);
+      }
+    }
+#endif
+  }
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+  ~MpiSession() {
+#ifdef NYSTROM_HAVE_MPI
+    if (active_) MPI_Finalize();
+#endif
+  }
+  bool active() const { return active_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+
+ private:
+  bool active_ = false;
+  int rank_ = 0, size_ = 1;
+};
+
+/// The potential's values from a text file: numbers separated by white space, `#` to the end of a line a
+/// comment, one per grid point in row-major order (last axis fastest), at x_i = -L/2 + i L/n.
+std::vector<double> read_potential_file(const std::string& path, std::size_t points) {
+  std::ifstream in(path);
+  if (path.empty() || std::filesystem::is_directory(path) || !in)
+    throw UsageError("cannot read --potential-file '" + path + "'");
+  std::vector<double> v;
+  std::string line;
+  for (long number = 1; std::getline(in, line); ++number) {
+    line = line.substr(0, line.find('#'));
+    std::istringstream words(line);
+    for (std::string w; words >> w;) {
+      if (v.size() == points)
+        throw UsageError("--potential-file '" + path + "' has more values than the " + std::to_string(points) +
+                         " grid points");
+      v.push_back(nystrom::cli::parse_double(w, "--potential-file value on line " + std::to_string(number)));
+    }
+  }
+  if (in.bad()) throw UsageError("cannot read --potential-file '" + path + "'");
+  if (v.size() != points)
+    throw UsageError("--potential-file '" + path + "' has " + std::to_string(v.size()) + " values for " +
+                     std::to_string(points) + " grid points");
+  return v;
+}
 
 /// "1" (first axis) or "1,0,-0.5" (one value per axis).
 std::vector<double> parse_vector(const std::string& text, const std::string& what, int dims) {
@@ -115,12 +185,19 @@ void plot_samples(const std::string& target, const QuantumResult& r, bool imagin
 }
 
 template <class R>
-QuantumResult run(const Options& o) {
+QuantumResult run(const Options& o, [[maybe_unused]] const MpiSession& mpi) {
   QuantumProblem<R> p;
+#ifdef NYSTROM_HAVE_MPI
+  if (mpi.active()) p.transforms = distributed_transforms<R>(MPI_COMM_WORLD);
+#endif
   p.dims = o.dims;
   p.grid = o.grid;
   p.box = static_cast<R>(nystrom::cli::parse_double(o.box, "--box", Bound::positive));
   p.potential = o.potential;
+  if (!o.potential_file.empty()) {
+    const Grid<R> grid(o.dims, o.grid, p.box);
+    for (double x : read_potential_file(o.potential_file, grid.size())) p.values.push_back(static_cast<R>(x));
+  }
   p.g = static_cast<R>(nystrom::cli::parse_double(o.g, "--g"));
   p.time = o.imaginary ? TimeKind::imaginary : TimeKind::real;
   for (double x : parse_vector(o.x0, "--x0", o.dims)) p.x0.push_back(static_cast<R>(x));
@@ -128,15 +205,18 @@ QuantumResult run(const Options& o) {
   p.width = static_cast<R>(nystrom::cli::parse_double(o.width, "--width", Bound::positive));
   p.fft.threads = o.threads;
   const R dt = static_cast<R>(nystrom::cli::parse_double(o.dt, "--dt", Bound::positive));
-  return solve(p, o.method, dt, o.steps, o.plot.empty() ? 0 : std::min<long>(o.steps, 400));
+  p.autocorrelation = o.autocorrelation;
+  p.states = o.states;
+  const long samples = o.autocorrelation ? o.steps : o.plot.empty() ? 0 : std::min<long>(o.steps, 400);
+  return solve(p, o.method, dt, o.steps, samples);
 }
 
-nlohmann::json to_json(const Options& o, const QuantumResult& r) {
+nlohmann::json to_json(const Options& o, const QuantumResult& r, int ranks) {
   auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
   nlohmann::json j;
   j["method"] = r.method;
   j["order"] = r.order;
-  j["potential"] = o.potential;
+  j["potential"] = o.potential_file.empty() ? o.potential : "file";
   j["dims"] = o.dims;
   j["grid"] = o.grid;
   j["box"] = nystrom::cli::parse_double(o.box, "--box", Bound::positive);
@@ -156,6 +236,13 @@ nlohmann::json to_json(const Options& o, const QuantumResult& r) {
   j["exact_error"] = num(r.exact_error);
   j["fft_count"] = r.fft_count;
   j["seconds"] = r.seconds;
+  j["ranks"] = ranks;
+  if (o.states > 1) j["energies"] = r.energies;
+  if (o.autocorrelation) {
+    auto& c = j["autocorrelation"] = nlohmann::json::array();
+    for (const auto& s : r.samples)
+      c.push_back({{"t", s.time}, {"re", s.autocorrelation.real()}, {"im", s.autocorrelation.imag()}});
+  }
   return j;
 }
 
@@ -165,6 +252,9 @@ nystrom::cli::Registrar reg(
       app.add_option("--potential", o->potential,
                      "harmonic, anisotropic, morse, double-well, soft-coulomb, free (docs/quantum.md)")
           ->capture_default_str();
+      app.add_option("--potential-file", o->potential_file,
+                     "The potential's values: one number per grid point, row-major (last axis fastest), at "
+                     "x_i = -L/2 + i L/n; # starts a comment (docs/quantum.md)");
       app.add_option("--dims", o->dims, "Dimensions: 1, 2 or 3")->capture_default_str();
       app.add_option("--grid", o->grid, "Grid points per axis")->capture_default_str();
       app.add_option("--box", o->box, "Box length L (the box is [-L/2, L/2) per axis)")->capture_default_str();
@@ -173,6 +263,8 @@ nystrom::cli::Registrar reg(
       app.add_option("--dt", o->dt, "Step (real or imaginary time)")->capture_default_str();
       app.add_option("--steps", o->steps, "Number of steps")->capture_default_str();
       app.add_flag("--imaginary-time", o->imaginary, "Propagate in imaginary time (ground state), renormalising");
+      app.add_option("--states", o->states, "Imaginary time: the N lowest states by orthogonalisation (JSON: energies)")
+          ->capture_default_str();
       app.add_option("--x0", o->x0, "Initial centre: one number (first axis) or one per axis, comma-separated")
           ->capture_default_str();
       app.add_option("--p0", o->p0, "Initial momentum, like --x0")->capture_default_str();
@@ -181,41 +273,48 @@ nystrom::cli::Registrar reg(
       app.add_option("--precision", o->precision, "double or long-double")->capture_default_str();
       app.add_option("--threads", o->threads, "FFTW threads")->capture_default_str();
       app.add_flag("--json", o->json, "Print one JSON object");
+      app.add_flag("--autocorrelation", o->autocorrelation,
+                   "Record C(t) = <psi(0)|psi(t)> after every step (JSON: autocorrelation, a list of {t, re, im})");
       app.add_option("--plot", o->plot, "Write <x_1>(t) (real time) or E(tau) (imaginary time) to this PNG");
       return [o]() {
         if (o->grid <= 0) throw UsageError("--grid must be positive, got " + std::to_string(o->grid));
         if (o->dims < 1 || o->dims > 3) throw UsageError("--dims must be 1, 2 or 3, got " + std::to_string(o->dims));
         if (o->steps < 0) throw UsageError("--steps must not be negative");
         if (o->threads < 1) throw UsageError("--threads must be positive");
+        if (o->states < 1 || o->states > 1000) throw UsageError("--states must be between 1 and 1000");
+        if (o->states > 1 && !o->imaginary) throw UsageError("--states needs --imaginary-time");
         nystrom::cli::parse_double(o->box, "--box", Bound::positive);
         nystrom::cli::parse_double(o->dt, "--dt", Bound::positive);
         nystrom::cli::parse_double(o->g, "--g");
-        QuantumResult r;
-        if (o->precision == "double")
-          r = run<double>(*o);
-        else if (o->precision == "long-double")
-          r = run<long double>(*o);
-        else
+        if (o->precision != "double" && o->precision != "long-double")
           throw UsageError("--precision must be double or long-double, got '" + o->precision + "'");
+        const MpiSession mpi;
+        const QuantumResult r = o->precision == "double" ? run<double>(*o, mpi) : run<long double>(*o, mpi);
+        if (mpi.rank() != 0) return 0;
         if (!o->plot.empty()) plot_samples(o->plot, r, o->imaginary);
         if (o->json) {
-          std::cout << to_json(*o, r).dump(2) << "\n";
+          std::cout << to_json(*o, r, mpi.size()).dump(2) << "\n";
           return 0;
         }
         fmt::print("method         {} (order {})\n", r.method, r.order);
-        fmt::print("problem        {} in {}D, {} points per axis, box {}, g = {}{}\n", o->potential, o->dims, o->grid,
-                   o->box, o->g, o->imaginary ? ", imaginary time" : "");
+        fmt::print("problem        {} in {}D, {} points per axis, box {}, g = {}{}\n",
+                   o->potential_file.empty() ? o->potential : "potential from file", o->dims, o->grid, o->box, o->g,
+                   o->imaginary ? ", imaginary time" : "");
         fmt::print("steps          {} of {:.6g} (time {:.6g})\n", r.steps, r.dt, r.time);
         fmt::print("norm           {:.15f} (drift {:+.3e})\n", r.norm, r.norm_drift);
         fmt::print("energy         {:.15f}\n", r.energy);
+        for (std::size_t n = 1; n < r.energies.size(); ++n) fmt::print("energy {:<7} {:.15f}\n", n, r.energies[n]);
         if (std::stod(o->g) != 0) fmt::print("chem. potential {:.15f}\n", r.chemical_potential);
         std::string mx;
         for (double x : r.mean_x) mx += fmt::format(" {:.12f}", x);
         fmt::print("<x>           {}\n", mx);
         if (!r.exact_solution.empty())
           fmt::print("error          {:.6e} (L2, against the {})\n", r.exact_error, r.exact_solution);
+        if (o->autocorrelation)
+          fmt::print("C(t)           {:.12f} {:+.12f} i\n", r.autocorrelation.real(), r.autocorrelation.imag());
         fmt::print("FFTs           {}\n", r.fft_count);
-        fmt::print("time           {:.6f} s\n", r.seconds);
+        fmt::print("time           {:.6f} s{}\n", r.seconds,
+                   mpi.size() > 1 ? fmt::format(" ({} MPI ranks)", mpi.size()) : std::string());
         return 0;
       };
     });

@@ -42,12 +42,13 @@ inline std::filesystem::path temp_dir() {
   return d;
 }
 
-/// Runs `nystrom ARGS` (the arguments are the test's own, passed through the shell as written); its stdout and
-/// stderr go to files in DIR (created if needed).
-inline Result run(const std::string& args, const std::filesystem::path& dir) {
+/// Runs `nystrom ARGS` (the arguments are the test's own, passed through the shell as written), after
+/// `launcher` when one is given (e.g. `mpiexec -np 2`); its stdout and stderr go to files in DIR (created if needed).
+inline Result run(const std::string& args, const std::filesystem::path& dir, const std::string& launcher = "") {
   std::filesystem::create_directories(dir);
   const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = tool() + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
+  const std::string cmd = (launcher.empty() ? "" : launcher + " ") + tool() + " " + args + " >" + out.string() + " 2>" +
+                          err.string() + " </dev/null";
   const int status = std::system(cmd.c_str());
   Result r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

@@ -8,6 +8,9 @@
 //   f.axpy(d, r, s)   d <- d + r s         (the linear combination of the multi-product expansion)
 // with F::state_type, F::real_type. Optional members the engines use when present:
 //   f.end_step(s)                 after every step (e.g. renormalisation in imaginary time);
+//   f.apply_b_gradient(s, z, w)   s <- e^{z B + w [B,[A,B]]} s: the modified potential of the forward
+//                                 (all-positive) fourth-order methods with a gradient term (a splitting with
+//                                 gradient coefficients needs it; for Schrodinger, [B,[A,B]] is a potential);
 //   f.merge_across_steps()        false forbids merging the last sub-step of a step with the first of the
 //                                 next (a flow that is not a group in its coefficient: e^{aB} e^{bB} !=
 //                                 e^{(a+b)B}, such as a nonlinear potential flow). Default: merge. When
@@ -57,19 +60,27 @@ bool merge_across_steps(const F& f) {
     return true;
 }
 
+/// One sub-step; w, the coefficient of [B,[A,B]] (gradient coefficient times h^3), is 0 for plain splittings.
 template <class F, class R>
-void apply(F& f, typename F::state_type& s, Flow which, std::complex<R> z) {
-  if (which == Flow::drift)
+void apply(F& f, typename F::state_type& s, Flow which, std::complex<R> z, std::complex<R> w = {}) {
+  if (which == Flow::drift) {
     f.apply_a(s, z);
-  else
+  } else if (w == std::complex<R>()) {
     f.apply_b(s, z);
+  } else if constexpr (requires { f.apply_b_gradient(s, z, w); }) {
+    f.apply_b_gradient(s, z, w);
+  } else {
+    throw std::invalid_argument("these flows have no gradient term [B,[A,B]] for a gradient method");
+  }
 }
 
 }  // namespace detail
 
 /// Runs a splitting scheme (real or complex coefficients) over flows F. Adjacent sub-steps of the same
 /// flow merge; in integrate() the last sub-step of a step merges with the first of the next unless the
-/// flows forbid it (merge_across_steps()).
+/// flows forbid it (merge_across_steps()). Optional gradient coefficients c_j, one per sub-step of the
+/// (normalised) scheme, make kick j the modified potential e^{h b_j B + h^3 c_j [B,[A,B]]} (Chin's forward
+/// methods; flows with apply_b_gradient()).
 template <OperatorFlows F>
 class SplittingFlowStepper {
  public:
@@ -78,18 +89,23 @@ class SplittingFlowStepper {
   using real_type = typename F::real_type;
   using complex_type = std::complex<real_type>;
 
-  explicit SplittingFlowStepper(const SplittingScheme<complex_type>& scheme) : scheme_(normalized(scheme)) {
+  explicit SplittingFlowStepper(const SplittingScheme<complex_type>& scheme, std::vector<complex_type> gradient = {})
+      : scheme_(normalized(scheme)), grad_(std::move(gradient)) {
     if (scheme_.steps.empty()) throw std::invalid_argument("splitting scheme has no sub-steps");
     for (const auto& s : scheme_.steps)
       if (!std::isfinite(s.coef.real()) || !std::isfinite(s.coef.imag()))
         throw std::invalid_argument("splitting coefficient is not finite");
+    if (grad_.empty())
+      grad_.assign(scheme_.steps.size(), complex_type());
+    else if (grad_.size() != scheme_.steps.size() || scheme.steps.size() != scheme_.steps.size())
+      throw std::invalid_argument("one gradient coefficient per sub-step of a scheme without adjacent equal flows");
   }
 
   const SplittingScheme<complex_type>& scheme() const { return scheme_; }
 
   /// The sub-steps of one step, without end_step().
   void apply_once(F& f, state_type& s, real_type h) const {
-    for (const auto& st : scheme_.steps) detail::apply(f, s, st.flow, st.coef * h);
+    for (std::size_t j = 0; j < scheme_.steps.size(); ++j) sub_step(f, s, j, h);
   }
 
   void step(F& f, state_type& s, real_type h) const {
@@ -105,11 +121,14 @@ class SplittingFlowStepper {
     }
     // the first sub-step; then per step the middle sub-steps and the last one merged with the next first
     const auto& st = scheme_.steps;
-    detail::apply(f, s, st.front().flow, st.front().coef * h);
+    sub_step(f, s, 0, h);
     const complex_type joined = (st.back().coef + st.front().coef) * h;
     for (long i = 0; i < n; ++i) {
-      for (std::size_t j = 1; j + 1 < st.size(); ++j) detail::apply(f, s, st[j].flow, st[j].coef * h);
-      detail::apply(f, s, st.back().flow, i + 1 < n ? joined : st.back().coef * h);
+      for (std::size_t j = 1; j + 1 < st.size(); ++j) sub_step(f, s, j, h);
+      if (i + 1 < n)
+        detail::apply(f, s, st.back().flow, joined);
+      else
+        sub_step(f, s, st.size() - 1, h);
       detail::end_step(f, s);
     }
   }
@@ -117,7 +136,8 @@ class SplittingFlowStepper {
   /// Whether integrate() merges the last sub-step of a step with the first of the next.
   bool merges(const F& f) const {
     const auto& st = scheme_.steps;
-    return st.size() > 1 && st.front().flow == st.back().flow && detail::merge_across_steps(f);
+    return st.size() > 1 && st.front().flow == st.back().flow && grad_.front() == complex_type() &&
+           grad_.back() == complex_type() && detail::merge_across_steps(f);
   }
 
   /// Applications of flow A and of flow B in n steps of integrate().
@@ -131,7 +151,12 @@ class SplittingFlowStepper {
   }
 
  private:
+  void sub_step(F& f, state_type& s, std::size_t j, real_type h) const {
+    detail::apply(f, s, scheme_.steps[j].flow, scheme_.steps[j].coef * h, grad_[j] * (h * h * h));
+  }
+
   SplittingScheme<complex_type> scheme_;
+  std::vector<complex_type> grad_;
 };
 
 /// Runs a multi-product expansion sum_i c_i B^{k_i}(h / k_i) over flows F, for any symmetric base

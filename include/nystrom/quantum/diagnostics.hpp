@@ -21,51 +21,70 @@ struct Observables {
   std::vector<R> mean_x, mean_p;
 };
 
+/// Collective on a distributed grid: every process calls it and gets the observables of the whole grid.
 template <class R>
 Observables<R> observe(const SchrodingerFlows<R>& f, const Field<R>& psi) {
   const Grid<R>& g = f.grid();
-  Observables<R> o;
-  o.mean_x.assign(static_cast<std::size_t>(g.dims), R(0));
-  o.mean_p.assign(static_cast<std::size_t>(g.dims), R(0));
-  int idx[3];
-  R n = 0, v = 0, rho2 = 0;
-  for (std::size_t i = 0; i < psi.size(); ++i) {
+  const std::size_t d = static_cast<std::size_t>(g.dims);
+  // the sums of one reduction: n, v, rho^2, nk, t, then x_a and p_a per axis
+  std::vector<R> s(5 + 2 * d, R(0));
+  for_each_point(g, f.range(), [&](std::size_t i, const int* idx) {
     const R rho = std::norm(psi[i]);
-    n += rho;
-    v += rho * f.potential()[i];
-    rho2 += rho * rho;
-    g.indices(i, idx);
-    for (int a = 0; a < g.dims; ++a) o.mean_x[a] += rho * g.coordinate(idx[a]);
-  }
+    s[0] += rho;
+    s[1] += rho * f.potential()[i];
+    s[2] += rho * rho;
+    for (std::size_t a = 0; a < d; ++a) s[5 + a] += rho * g.coordinate(idx[a]);
+  });
   Field<R> hat = psi;
   f.fft().forward(hat);
-  R nk = 0, t = 0;
-  for (std::size_t i = 0; i < hat.size(); ++i) {
+  for_each_point(g, f.range(), [&](std::size_t i, const int* idx) {
     const R w = std::norm(hat[i]);
-    nk += w;
-    t += w * f.half_k2()[i];
-    g.indices(i, idx);
-    for (int a = 0; a < g.dims; ++a) o.mean_p[a] += w * g.wavenumber(idx[a]);
-  }
+    s[3] += w;
+    s[4] += w * f.half_k2()[i];
+    for (std::size_t a = 0; a < d; ++a) s[5 + d + a] += w * g.wavenumber(idx[a]);
+  });
+  f.fft().sum(s.data(), static_cast<int>(s.size()));
+  const R n = s[0], nk = s[3];
+  Observables<R> o;
+  o.mean_x.assign(s.begin() + 5, s.begin() + 5 + static_cast<std::ptrdiff_t>(d));
+  o.mean_p.assign(s.begin() + 5 + static_cast<std::ptrdiff_t>(d), s.end());
   o.norm = n * g.cell();
-  if (!(n > 0) || !(nk > 0)) return o;
+  if (!(n > 0) || !(nk > 0)) {
+    o.mean_x.assign(d, R(0));
+    o.mean_p.assign(d, R(0));
+    return o;
+  }
   for (auto& x : o.mean_x) x /= n;
   for (auto& p : o.mean_p) p /= nk;
-  o.kinetic = t / nk;
-  o.potential = v / n;
+  o.kinetic = s[4] / nk;
+  o.potential = s[1] / n;
   // g int |psi|^4 / (int |psi|^2)^2, the integrals as sums times dx^d
-  o.interaction = f.coupling() * (rho2 * g.cell()) / (o.norm * o.norm);
+  o.interaction = f.coupling() * (s[2] * g.cell()) / (o.norm * o.norm);
   o.energy = o.kinetic + o.potential + o.interaction / 2;
   o.chemical_potential = o.kinetic + o.potential + o.interaction;
   return o;
 }
 
-/// (integral |a - b|^2)^{1/2}.
+/// <a|b> = integral conj(a) b over the whole grid (collective on a distributed grid).
 template <class R>
-R l2_distance(const Grid<R>& g, const Field<R>& a, const Field<R>& b) {
+std::complex<R> overlap(const SchrodingerFlows<R>& f, const Field<R>& a, const Field<R>& b) {
+  R s[2] = {0, 0};
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::complex<R> x = std::conj(a[i]) * b[i];
+    s[0] += x.real();
+    s[1] += x.imag();
+  }
+  f.fft().sum(s, 2);
+  return std::complex<R>(s[0], s[1]) * f.grid().cell();
+}
+
+/// (integral |a - b|^2)^{1/2} over the whole grid (collective on a distributed grid).
+template <class R>
+R l2_distance(const SchrodingerFlows<R>& f, const Field<R>& a, const Field<R>& b) {
   R s = 0;
   for (std::size_t i = 0; i < a.size(); ++i) s += std::norm(a[i] - b[i]);
-  return std::sqrt(s * g.cell());
+  f.fft().sum(&s, 1);
+  return std::sqrt(s * f.grid().cell());
 }
 
 }  // namespace nystrom::quantum

@@ -95,16 +95,32 @@ inline std::mutex& fftw_planner_mutex() {
   return m;
 }
 
+/// The transforms of one grid as the flows see them: forward and backward in place on the points this
+/// process holds, which are the flat (row-major) indices [first(), first() + local_size()) of the grid, and
+/// the sum of a few numbers over all processes. FftPair holds the whole grid; a distributed grid
+/// (quantum/fftw_mpi.hpp) holds a slab of the first axis per MPI rank, in position and Fourier space alike.
+template <class R>
+class FftTransforms {
+ public:
+  virtual ~FftTransforms() = default;
+  /// Unnormalised: backward(forward(f)) = N f, N the points of the whole grid.
+  virtual void forward(Field<R>& f) const = 0;
+  virtual void backward(Field<R>& f) const = 0;
+  virtual std::size_t first() const = 0;
+  virtual std::size_t local_size() const = 0;
+  /// x_i <- sum over the processes of x_i, i < n (nothing to do on one process).
+  virtual void sum(R* x, int n) const = 0;
+};
+
 /// Forward and backward in-place transforms of one shape, usable on every Field of that shape.
 template <class R>
-class FftPair {
+class FftPair final : public FftTransforms<R> {
  public:
   using traits = FftwTraits<R>;
 
   FftPair(const std::vector<int>& shape, const FftOptions& opt) {
-    std::size_t total = 1;
-    for (int n : shape) total *= static_cast<std::size_t>(n);
-    Field<R> scratch(total);
+    for (int n : shape) total_ *= static_cast<std::size_t>(n);
+    Field<R> scratch(total_);
     std::lock_guard<std::mutex> lock(fftw_planner_mutex());
 #ifdef NYSTROM_HAVE_FFTW_THREADS
     static const bool threads_ok = traits::init_threads() != 0;
@@ -126,17 +142,20 @@ class FftPair {
     if (bwd_) traits::destroy(bwd_);
   }
 
-  /// Unnormalised: backward(forward(f)) = N f.
-  void forward(Field<R>& f) const {
+  void forward(Field<R>& f) const override {
     auto* p = reinterpret_cast<typename traits::complex*>(f.data());
     traits::execute(fwd_, p, p);
   }
-  void backward(Field<R>& f) const {
+  void backward(Field<R>& f) const override {
     auto* p = reinterpret_cast<typename traits::complex*>(f.data());
     traits::execute(bwd_, p, p);
   }
+  std::size_t first() const override { return 0; }
+  std::size_t local_size() const override { return total_; }
+  void sum(R*, int) const override {}
 
  private:
+  std::size_t total_ = 1;
   typename traits::plan fwd_{}, bwd_{};
 };
 

@@ -48,22 +48,24 @@ class SchrodingerFlows {
   using real_type = R;
   using complex_type = std::complex<R>;
 
+  /// `potential`: the values on the whole grid (sample_potential()).
   SchrodingerFlows(const Grid<R>& grid, std::vector<R> potential, TimeKind kind, R g = 0, FftOptions fft = {})
-      : grid_(grid),
-        v_(std::move(potential)),
-        kind_(kind),
-        g_(g),
-        fft_(std::make_unique<FftPair<R>>(grid.shape(), fft)) {
-    if (v_.size() != grid_.size()) throw std::invalid_argument("potential and grid differ in size");
+      : SchrodingerFlows(grid, std::move(potential), kind, g, std::make_unique<FftPair<R>>(grid.shape(), fft)) {}
+
+  /// Over given transforms, e.g. a grid distributed over MPI ranks (quantum/fftw_mpi.hpp): `potential` holds
+  /// the values on the points of this process (sample_potential(grid, v, range)).
+  SchrodingerFlows(const Grid<R>& grid, std::vector<R> potential, TimeKind kind, R g,
+                   std::unique_ptr<FftTransforms<R>> transforms)
+      : grid_(grid), v_(std::move(potential)), kind_(kind), g_(g), fft_(std::move(transforms)) {
+    if (!fft_) throw std::invalid_argument("no transforms");
+    if (v_.size() != fft_->local_size()) throw std::invalid_argument("potential and grid differ in size");
     if (!std::isfinite(static_cast<double>(g))) throw std::invalid_argument("g must be finite");
-    k2half_.resize(grid_.size());
-    int idx[3];
-    for (std::size_t i = 0; i < k2half_.size(); ++i) {
-      grid_.indices(i, idx);
+    k2half_.resize(v_.size());
+    for_each_point(grid_, range(), [&](std::size_t i, const int* idx) {
       R k2 = 0;
       for (int a = 0; a < grid_.dims; ++a) k2 += grid_.wavenumber(idx[a]) * grid_.wavenumber(idx[a]);
       k2half_[i] = k2 / 2;
-    }
+    });
   }
 
   const Grid<R>& grid() const { return grid_; }
@@ -71,7 +73,16 @@ class SchrodingerFlows {
   const std::vector<R>& half_k2() const { return k2half_; }
   TimeKind kind() const { return kind_; }
   R coupling() const { return g_; }
-  const FftPair<R>& fft() const { return *fft_; }
+  const FftTransforms<R>& fft() const { return *fft_; }
+  /// The points of the grid this process holds (all of them unless the grid is distributed).
+  PointRange range() const { return {fft_->first(), fft_->local_size()}; }
+  /// integral |psi|^2 over the whole grid.
+  R norm2(const state_type& psi) const {
+    R sum = 0;
+    for (const auto& x : psi) sum += std::norm(x);
+    fft_->sum(&sum, 1);
+    return sum * grid_.cell();
+  }
   long fft_count() const { return ffts_; }
   void reset_fft_count() { ffts_ = 0; }
   /// Bound on the number of cached exponential tables (each one field); beyond it they are computed per use.
@@ -105,6 +116,35 @@ class SchrodingerFlows {
     for (std::size_t i = 0; i < psi.size(); ++i) psi[i] *= std::exp(s * z * (v_[i] - shift + g_ * std::norm(psi[i])));
   }
 
+  /// e^{z B + w [B,[A,B]]}: [V,[T,V]] = |grad V|^2 (m = 1), so [B,[A,B]] = s^3 |grad V|^2 with s = -i (real
+  /// time) or -1 (imaginary time): the potential sub-step of a forward method with a gradient term
+  /// (operators/flows.hpp). Needs set_gradient_term() and g = 0.
+  void apply_b_gradient(state_type& psi, complex_type z, complex_type w) {
+    if (g_ != 0) throw std::invalid_argument("gradient methods need g = 0 (no Gross-Pitaevskii term)");
+    if (grad2_.size() != v_.size()) throw std::invalid_argument("the gradient term |grad V|^2 is not set");
+    const Field<R>* table = nullptr;
+    for (const auto& t : cache_g_)
+      if (t.z == z && t.w == w) table = &t.values;
+    if (!table) {
+      Field<R>* out = &scratch_;
+      if (cache_g_.size() < cache_limit_) {
+        cache_g_.push_back({z, w, {}});
+        out = &cache_g_.back().values;
+      }
+      const complex_type s = sign(), sz = s * z, s3w = s * s * s * w;
+      out->resize(v_.size());
+      for (std::size_t i = 0; i < v_.size(); ++i) (*out)[i] = std::exp(sz * v_[i] + s3w * grad2_[i]);
+      table = out;
+    }
+    multiply(psi, *table);
+  }
+  /// |grad V|^2 on the points of this process (sample_gradient_squared()), for apply_b_gradient().
+  void set_gradient_term(std::vector<R> grad2) {
+    if (grad2.size() != v_.size()) throw std::invalid_argument("gradient term and grid differ in size");
+    grad2_ = std::move(grad2);
+    cache_g_.clear();
+  }
+
   // ---- the vector space ----
   void assign(state_type& d, const state_type& s) const { d = s; }
   void scale(state_type& s, R r) const {
@@ -122,9 +162,7 @@ class SchrodingerFlows {
   void end_step(state_type& psi) {
     if (kind_ != TimeKind::imaginary) return;
     if (g_ != 0 && step_ > 0) {
-      R sum = 0;
-      for (const auto& x : psi) sum += std::norm(x);
-      const R n2 = sum * grid_.cell();
+      const R n2 = norm2(psi);
       if (n2 > 0 && std::isfinite(static_cast<double>(n2))) shift_ += -std::log(n2) / (2 * step_);
     }
     renormalize(psi);
@@ -135,9 +173,7 @@ class SchrodingerFlows {
   R chemical_potential_shift() const { return shift_; }
   bool merge_across_steps() const { return g_ == 0 || kind_ == TimeKind::real; }
   void renormalize(state_type& psi) const {
-    R sum = 0;
-    for (const auto& x : psi) sum += std::norm(x);
-    const R n = std::sqrt(sum * grid_.cell());
+    const R n = std::sqrt(norm2(psi));
     if (!(n > 0) || !std::isfinite(static_cast<double>(n)))
       throw std::runtime_error("the wave function vanished or overflowed (norm " + std::to_string(double(n)) + ")");
     scale(psi, 1 / n);
@@ -146,6 +182,10 @@ class SchrodingerFlows {
  private:
   struct Table {
     complex_type z;
+    Field<R> values;
+  };
+  struct GradientTable {
+    complex_type z, w;
     Field<R> values;
   };
 
@@ -183,8 +223,10 @@ class SchrodingerFlows {
   std::vector<R> v_, k2half_;
   TimeKind kind_;
   R g_;
-  std::unique_ptr<FftPair<R>> fft_;
+  std::unique_ptr<FftTransforms<R>> fft_;
   std::vector<Table> cache_a_, cache_b_;
+  std::vector<GradientTable> cache_g_;
+  std::vector<R> grad2_;
   Field<R> scratch_;
   std::size_t cache_limit_ = 64;
   long ffts_ = 0;
