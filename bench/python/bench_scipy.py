@@ -7,12 +7,16 @@ q'' = a(q) with the same Python force a(q), and with the built-in (C++) force. T
 time of nystrom.solve on the built-in force against the C++ library's own fixed-step loop
 (experiments/kepler.hpp) on the same steps, and against the library's solve() call inside it (res.solve_seconds).
 
-    PYTHONPATH=<build>/python python3 bench/python/bench_scipy.py [--quick] [--json FILE]
+    PYTHONPATH=<build>/python python3 bench/python/bench_scipy.py [--quick] [--json FILE] [--plot FILE.png]
+
+--plot draws the work-precision chart (final error against wall time, one line per integrator) with matplotlib.
 """
 import argparse
 import json
 import math
+import os
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -46,10 +50,49 @@ def timed(fn, repeat):
     return best, out
 
 
+def write_atomically(path, write):
+    """Writes through write(temporary_path) and renames onto path, so that path is never left half written."""
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".bench_scipy-", suffix=os.path.splitext(path)[1])
+    os.close(fd)
+    try:
+        write(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's file is private; a result file gets the usual permissions
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
+def plot_work_precision(runs, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    for who in dict.fromkeys(r["integrator"] for r in runs):
+        pts = sorted((r["seconds"], r["error"]) for r in runs if r["integrator"] == who and r["error"] > 0)
+        if pts:
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-" if who.startswith("nystrom") else "s--",
+                      label=who, ms=4)
+    for target in TARGETS:
+        ax.axhline(target, color="0.8", lw=0.8, zorder=0)
+    ax.set_xlabel("wall time [s]")
+    ax.set_ylabel("final position error")
+    ax.set_title(f"Kepler e = {E}, {PERIODS} periods: nystrom from Python against scipy's solve_ivp")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer tolerances, one repetition")
     ap.add_argument("--json", help="write all runs to this file")
+    ap.add_argument("--plot", help="write the work-precision chart (PNG) to this file")
     args = ap.parse_args()
     repeat = 1 if args.quick else 3
     prob = Kepler(E)
@@ -135,10 +178,15 @@ def main():
     print(f"a Python force call through nystrom.solve (M8, fixed steps): {1e6 * per_call:.2f} us, the bare call "
           f"{1e6 * per_call_bare:.2f} us")
     if args.json:
-        with open(args.json, "w") as f:
-            json.dump(dict(runs=runs, summary=summary, overhead=overhead, library_seconds=lib, module_seconds=mod,
-                           solve_seconds=in_solve,
-                           python_call_seconds=per_call, bare_call_seconds=per_call_bare), f, indent=1)
+        doc = dict(runs=runs, summary=summary, overhead=overhead, library_seconds=lib, module_seconds=mod,
+                   solve_seconds=in_solve, python_call_seconds=per_call, bare_call_seconds=per_call_bare)
+
+        def dump(tmp):
+            with open(tmp, "w") as f:
+                json.dump(doc, f, indent=1)
+        write_atomically(args.json, dump)
+    if args.plot:
+        plot_work_precision(runs, args.plot)
     return 0
 
 
