@@ -107,13 +107,6 @@ std::string full_string(const T& x) {
 
 // ---- the run ---------------------------------------------------------------------------------------------
 
-template <class V>
-V sized(std::size_t m) {
-  V x{};
-  if constexpr (!is_std_array<V>::value) x.resize(m);
-  return x;
-}
-
 /// The first n coordinates of x as doubles, appended to out.
 template <class V>
 void append_doubles(const V& x, std::size_t n, std::vector<double>& out) {
@@ -161,7 +154,7 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   using R = real_t<typename V::value_type>;
   const std::size_t n = r.q0.size();
   const std::size_t m = n + (time_coordinate ? 1 : 0);
-  V q0 = sized<V>(m), v0 = sized<V>(m);
+  V q0 = solve_detail::make_vector<V>(m), v0 = solve_detail::make_vector<V>(m);
   if (q0.size() != m)
     throw invalid_input("the state has " + std::to_string(n) + " coordinates, this problem " +
                         std::to_string(q0.size()));
