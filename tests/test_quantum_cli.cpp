@@ -129,7 +129,7 @@ TEST(QuantumCli, BadPotentialFileExitsTwoWithOneLine) {
   inf += "inf";
   word += "x1";
   const std::string many = few + "1 1";
-  for (const std::string f :
+  for (const std::string& f :
        {write("few.txt", few), write("many.txt", many), write("nan.txt", nan), write("inf.txt", inf),
         write("word.txt", word), (dir / "missing.txt").string(), dir.string()}) {
     const auto r = run("quantum --grid 8 --steps 2 --potential-file " + f);
