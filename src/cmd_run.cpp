@@ -20,6 +20,7 @@ struct Options {
   bool json = false;
   double years = 0;  // outer-solar-system
   bool no_reference = false;
+  bool h_given = false;  // --h on the command line (outer-solar-system's default step differs from nbody's)
 };
 
 nystrom::cli::Registrar reg("run", "Integrate one problem with one method and report its errors", [](CLI::App& app) {
@@ -35,9 +36,11 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--ic", o->req.ic_file, "nbody: particle file (m x y z vx vy vz per line)");
   app.add_option("--eps2", o->req.eps2, "nbody: softening squared (default (1/N)^2; twobody 0)")
       ->check(nystrom::cli::non_negative_check());
-  auto* h_option = app.add_option("--h", o->req.h, "nbody: step size; outer-solar-system: step in days (default 100)")
-                       ->capture_default_str()
-                       ->check(nystrom::cli::positive_check());
+  // Recorded while parsing: the action runs after the parser (and its options) are gone.
+  app.add_option("--h", o->req.h, "nbody: step size; outer-solar-system: step in days (default 100)")
+      ->capture_default_str()
+      ->check(nystrom::cli::positive_check())
+      ->each([o](const std::string&) { o->h_given = true; });
   app.add_option("--years", o->years, "outer-solar-system: years of 365.25 days (default 1000)")
       ->check(nystrom::cli::positive_check());
   app.add_flag("--no-reference", o->no_reference, "outer-solar-system: skip the long double reference run");
@@ -68,10 +71,10 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--restart", o->sreq.restart,
                  "Kepler: continue from a checkpoint file (the other options must match)");
   app.add_flag("--json", o->json, "Print one JSON object");
-  return [o, h_option]() {
+  return [o]() {
     if (o->req.problem == "outer-solar-system") {
       nystrom::cli::PlanetaryRequest p{.method = o->method,
-                                       .h = h_option->count() > 0 ? o->req.h : 100.0,
+                                       .h = o->h_given ? o->req.h : 100.0,
                                        .years = o->years > 0 ? o->years : 1e3,
                                        .precision = o->req.precision,
                                        .tol = o->req.tol,
