@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <fmt/core.h>
+#include <mpfr.h>
 
 #include "cli.hpp"
 #include "nystrom/methods/catalog.hpp"
@@ -184,6 +185,10 @@ nlohmann::json run_planetary(const PlanetaryRequest& req) {
   std::future<Outcome> reference;
   if (req.reference)
     reference = std::async(std::launch::async, [&] {
+      // MPFR keeps per-thread caches (of constants such as pi) until the thread frees them (MPFR's manual).
+      struct FreeMpfrCache {
+        ~FreeMpfrCache() { mpfr_free_cache(); }
+      } free_cache;
       return run_map<long double>(kReferenceMethod, static_cast<long double>(req.h) / ref_factor, steps * ref_factor);
     });
   Outcome o;
