@@ -28,6 +28,61 @@
 
 namespace nystrom {
 
+/// The loop of a splitting scheme over any pair of flows, shared by the classical engine (drift and kick with
+/// a force cache, below) and the operator layer (operators/flows.hpp: any e^{h(A+B)}). hc holds the m
+/// sub-steps' coefficients times h in the order of application; drift(c, j) and kick(c, j) apply sub-step j
+/// (0 .. m - 1) with coefficient c; step_end() runs after each step.
+///
+/// Steps that merge (the first and last sub-steps are of the same flow, which after normalisation means that
+/// the m sub-steps alternate, m odd and >= 3): n steps in which the last sub-step of a step and the first of
+/// the next run as one sub-step of coefficient `joined`, with step_end() right after it (and after the final
+/// sub-step). The n steps run as n (m - 1) / 2 pairs of sub-steps of known flows and then the last sub-step:
+/// the same operations in the same order as sub-step by sub-step, but without a branch on the flow, so that
+/// the compiler inlines drift and kick and keeps a fixed-size state in registers (bench_kepler: the library's
+/// VV and FR against hand-written loops).
+template <class C, class Drift, class Kick, class StepEnd>
+NYSTROM_ALWAYS_INLINE inline void run_merged_splitting(bool kick_first, const C* hc, std::size_t m, long n,
+                                                       const C& joined, Drift&& drift, Kick&& kick,
+                                                       StepEnd&& step_end) {
+  const long pairs = n * static_cast<long>((m - 1) / 2);
+  std::size_t i = 0;  // position of the pair in the step
+  for (long p = 0; p < pairs; ++p) {
+    const C& c0 = i == 0 && p != 0 ? joined : hc[i];
+    if (kick_first)
+      kick(c0, i);
+    else
+      drift(c0, i);
+    if (i == 0 && p != 0) step_end();
+    if (kick_first)
+      drift(hc[i + 1], i + 1);
+    else
+      kick(hc[i + 1], i + 1);
+    i += 2;
+    if (i + 1 >= m) i = 0;
+  }
+  if (kick_first)
+    kick(hc[m - 1], m - 1);
+  else
+    drift(hc[m - 1], m - 1);
+  step_end();
+}
+
+/// Steps that do not merge: n steps of the m sub-steps one after the other (flows[j]: the flow of sub-step j),
+/// step_end() after each.
+template <class C, class Drift, class Kick, class StepEnd>
+NYSTROM_ALWAYS_INLINE inline void run_sequential_splitting(const Flow* flows, const C* hc, std::size_t m, long n,
+                                                           Drift&& drift, Kick&& kick, StepEnd&& step_end) {
+  for (long k = 0; k < n; ++k) {
+    for (std::size_t j = 0; j < m; ++j) {
+      if (flows[j] == Flow::drift)
+        drift(hc[j], j);
+      else
+        kick(hc[j], j);
+    }
+    step_end();
+  }
+}
+
 template <class V, class Force>
 class SplittingStepper {
  public:
@@ -42,6 +97,7 @@ class SplittingStepper {
       if (!is_finite_scalar(s.coef)) throw std::invalid_argument("splitting coefficient is not finite");
     const auto& st = scheme_.steps;
     merged_ = !project_ && st.size() > 1 && st.front().flow == st.back().flow;
+    for (const auto& x : st) flows_.push_back(x.flow);
   }
 
   const SplittingScheme<scalar_type>& scheme() const { return scheme_; }
@@ -118,39 +174,23 @@ class SplittingStepper {
     long evals = 0;
     const auto& st = scheme_.steps;
     const std::size_t m = st.size();
-    // Merged steps. After normalization drifts and kicks alternate (m is odd, the first and last
-    // sub-steps are of the same flow), so the n steps run as n (m - 1) / 2 pairs of sub-steps of known
-    // flows and then the last sub-step: every kick follows a drift and evaluates the force, except a
-    // first kick that finds a valid cached force. The same operations in the same order as sub-step by
-    // sub-step, but without a branch on the flow and with a single force call in the loop (so that the
-    // compiler inlines it and keeps the state in registers).
+    // Merged steps: every kick follows a drift and evaluates the force, except a first kick that finds a
+    // valid cached force.
     const bool kick_first = st.front().flow == Flow::kick;
-    const scalar_type joined = hc[m - 1] + hc[0];
-    const long pairs = n * static_cast<long>((m - 1) / 2);
-    scalar_type first = hc[0];  // the coefficient that starts a step: hc[0], then the merged one
-    std::size_t i = 0;          // position of the pair in the step
-    for (long p = 0; p < pairs; ++p) {
-      const scalar_type& c0 = i == 0 ? first : hc[i];
-      if (!kick_first) drift(c0);
-      if (!(kick_first && p == 0 && valid)) {
-        force_(x.q, a);
-        ++evals;
-      }
-      kick(kick_first ? c0 : hc[i + 1]);
-      if (kick_first) drift(hc[i + 1]);
-      i += 2;
-      if (i + 1 >= m) {
-        i = 0;
-        first = joined;
-      }
-    }
-    if (kick_first) {
-      force_(x.q, a);
-      ++evals;
-      kick(hc[m - 1]);
-    } else {
-      drift(hc[m - 1]);
-    }
+    bool cached = kick_first && valid;
+    run_merged_splitting(
+        kick_first, hc, m, n, scalar_type(hc[m - 1] + hc[0]),
+        [&](const scalar_type& c, std::size_t) NYSTROM_ALWAYS_INLINE { drift(c); },
+        [&](const scalar_type& c, std::size_t) NYSTROM_ALWAYS_INLINE {
+          if (cached) {
+            cached = false;
+          } else {
+            force_(x.q, a);
+            ++evals;
+          }
+          kick(c);
+        },
+        []() NYSTROM_ALWAYS_INLINE {});
     valid = kick_first;
     evals_ += evals;
   }
@@ -278,39 +318,39 @@ class SplittingStepper {
     std::conditional_t<local, V, V&> a = a_io, cq = cq_io, cv = cv_io;
     bool valid = valid_io;
     long evals = 0;
-    const auto& st = scheme_.steps;
-    for (long k = 0; k < n; ++k) {
-      for (std::size_t i = 0; i < st.size(); ++i) {
-        if (st[i].flow == Flow::drift) {
+    run_sequential_splitting(
+        flows_.data(), hc, flows_.size(), n,
+        [&](const scalar_type& c, std::size_t) {
           if constexpr (Comp) {
-            for (std::size_t j = 0; j < x.q.size(); ++j) compensated_add(x.q[j], cq[j], scalar_type(hc[i] * x.v[j]));
+            for (std::size_t j = 0; j < x.q.size(); ++j) compensated_add(x.q[j], cq[j], scalar_type(c * x.v[j]));
           } else {
-            axpy(x.q, hc[i], x.v);
+            axpy(x.q, c, x.v);
           }
           valid = false;
-        } else {
+        },
+        [&](const scalar_type& c, std::size_t) {
           if (!valid) {
             force_(x.q, a);
             ++evals;
             valid = true;
           }
           if constexpr (Comp) {
-            for (std::size_t j = 0; j < x.v.size(); ++j) compensated_add(x.v[j], cv[j], scalar_type(hc[i] * a[j]));
+            for (std::size_t j = 0; j < x.v.size(); ++j) compensated_add(x.v[j], cv[j], scalar_type(c * a[j]));
           } else {
-            axpy(x.v, hc[i], a);
+            axpy(x.v, c, a);
           }
-        }
-      }
-      if (project_) {
-        project_real(x.q);
-        project_real(x.v);
-        if constexpr (Comp) {
-          project_real(cq);
-          project_real(cv);
-        }
-        valid = false;
-      }
-    }
+        },
+        [&] {
+          if (project_) {
+            project_real(x.q);
+            project_real(x.v);
+            if constexpr (Comp) {
+              project_real(cq);
+              project_real(cv);
+            }
+            valid = false;
+          }
+        });
     if constexpr (local) {
       s = x;
       a_io = a;
@@ -372,7 +412,8 @@ class SplittingStepper {
   Force force_;
   EngineOptions opt_;
   bool project_ = is_complex_v<scalar_type> && !opt_.keep_complex;  // drop imaginary parts after each step
-  bool merged_ = false;  // the last sub-step of a step merges with the first of the next
+  bool merged_ = false;      // the last sub-step of a step merges with the first of the next
+  std::vector<Flow> flows_;  // the flow of each sub-step
   Compensator<V> comp_;
   V a_{};
   V aq_{};

@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "nystrom/engines/splitting.hpp"
 #include "nystrom/methods/splitting_scheme.hpp"
 
 namespace nystrom::operators {
@@ -104,9 +105,7 @@ class SplittingFlowStepper {
   const SplittingScheme<complex_type>& scheme() const { return scheme_; }
 
   /// The sub-steps of one step, without end_step().
-  void apply_once(F& f, state_type& s, real_type h) const {
-    for (std::size_t j = 0; j < scheme_.steps.size(); ++j) sub_step(f, s, j, h);
-  }
+  void apply_once(F& f, state_type& s, real_type h) const { run(f, s, h, 1, false, false); }
 
   void step(F& f, state_type& s, real_type h) const {
     apply_once(f, s, h);
@@ -114,23 +113,7 @@ class SplittingFlowStepper {
   }
 
   void integrate(F& f, state_type& s, real_type h, long n) const {
-    if (n <= 0) return;
-    if (!merges(f)) {
-      for (long i = 0; i < n; ++i) step(f, s, h);
-      return;
-    }
-    // the first sub-step; then per step the middle sub-steps and the last one merged with the next first
-    const auto& st = scheme_.steps;
-    sub_step(f, s, 0, h);
-    const complex_type joined = (st.back().coef + st.front().coef) * h;
-    for (long i = 0; i < n; ++i) {
-      for (std::size_t j = 1; j + 1 < st.size(); ++j) sub_step(f, s, j, h);
-      if (i + 1 < n)
-        detail::apply(f, s, st.back().flow, joined);
-      else
-        sub_step(f, s, st.size() - 1, h);
-      detail::end_step(f, s);
-    }
+    if (n > 0) run(f, s, h, n, merges(f), true);
   }
 
   /// Whether integrate() merges the last sub-step of a step with the first of the next.
@@ -151,8 +134,28 @@ class SplittingFlowStepper {
   }
 
  private:
-  void sub_step(F& f, state_type& s, std::size_t j, real_type h) const {
-    detail::apply(f, s, scheme_.steps[j].flow, scheme_.steps[j].coef * h, grad_[j] * (h * h * h));
+  /// n steps through the classical engine's loop (run_merged_splitting, run_sequential_splitting of
+  /// engines/splitting.hpp): merged across steps when `merge`, with end_step() after each step when `end`.
+  void run(F& f, state_type& s, real_type h, long n, bool merge, bool end) const {
+    const auto& st = scheme_.steps;
+    const std::size_t m = st.size();
+    std::vector<complex_type> hc(m);
+    std::vector<Flow> flows(m);
+    for (std::size_t j = 0; j < m; ++j) {
+      hc[j] = st[j].coef * h;
+      flows[j] = st[j].flow;
+    }
+    const real_type g = h * h * h;
+    auto drift = [&](const complex_type& z, std::size_t) { f.apply_a(s, z); };
+    auto kick = [&](const complex_type& z, std::size_t j) { detail::apply(f, s, Flow::kick, z, grad_[j] * g); };
+    auto step_end = [&] {
+      if (end) detail::end_step(f, s);
+    };
+    if (merge)
+      run_merged_splitting(st.front().flow == Flow::kick, hc.data(), m, n,
+                           complex_type((st.back().coef + st.front().coef) * h), drift, kick, step_end);
+    else
+      run_sequential_splitting(flows.data(), hc.data(), m, n, drift, kick, step_end);
   }
 
   SplittingScheme<complex_type> scheme_;
