@@ -25,6 +25,9 @@
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/plummer.hpp"
 #include "solve_binding.hpp"
+#ifdef NYSTROM_PYTHON_QUANTUM
+#include "quantum_binding.hpp"
+#endif
 
 namespace py = pybind11;
 using namespace nystrom;
@@ -286,4 +289,8 @@ PYBIND11_MODULE(_core, m) {
       py::arg("max_steps"), py::arg("progress"),
       "solve() (nystrom/solve.hpp) on a built-in problem (problem: its name) or a Python force(t, q) "
       "(problem: ''); nystrom.solve checks the arguments and wraps the result.");
+
+#ifdef NYSTROM_PYTHON_QUANTUM
+  register_quantum(m);
+#endif
 }
