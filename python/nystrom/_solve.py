@@ -51,20 +51,39 @@ class DenseSolution:
     """``sol(t) -> (q, v)``: the state at any t of the integrated span, continued from the step end before t
     by one step of the solution's own method (the library's dense output), so with the method's accuracy;
     each time costs one step's force evaluations. For an array of times the leading axis runs over the
-    times."""
+    times.
 
-    def __init__(self, core, rows, shape):
+    It pickles (so that it comes back from an ensemble's worker processes) as the arguments of the run that
+    made it: the method's engine and the force it continues with are compiled code, so the unpickled copy
+    repeats that run (deterministic, so sol(t) is bitwise the same) at its first use. The force and the
+    event functions must then be picklable (module-level functions or built-in problems)."""
+
+    def __init__(self, core, rows, shape, recipe=None):
         self._core = core
         self._rows = rows
         self._shape = tuple(shape)
+        self._recipe = recipe
+
+    def _built(self):
+        if self._core is None:
+            other = solve(**self._recipe).sol
+            self._core, self._rows = other._core, other._rows
+        return self._core
+
+    def __reduce__(self):
+        if self._recipe is None:
+            raise TypeError("this DenseSolution cannot be pickled: its run's arguments were not kept")
+        return (_dense_from_recipe, (self._recipe, self._shape))
 
     @property
     def t_min(self):
-        return min(self._core.t_first, self._core.t_last)
+        core = self._built()
+        return min(core.t_first, core.t_last)
 
     @property
     def t_max(self):
-        return max(self._core.t_first, self._core.t_last)
+        core = self._built()
+        return max(core.t_first, core.t_last)
 
     def __call__(self, t):
         ts = np.asarray(t, dtype=float)
@@ -72,11 +91,16 @@ class DenseSolution:
         ts = np.ascontiguousarray(ts.reshape(-1))
         if not np.all(np.isfinite(ts)):
             raise ValueError("sol(t): times must be finite")
-        q, v = self._core(ts)
+        q, v = self._built()(ts)
         q, v = self._rows(q), self._rows(v)
         if scalar:
             return q[0], v[0]
         return q, v
+
+
+def _dense_from_recipe(recipe, shape):
+    """An unpickled DenseSolution: the run is repeated at its first use."""
+    return DenseSolution(None, None, shape, recipe)
 
 
 def _positive(name, x):
@@ -224,6 +248,13 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     -------
     OdeResult
     """
+    # What repeats this run for an unpickled dense output (output times and progress do not change the steps).
+    def kept(x):
+        return np.copy(x) if isinstance(x, np.ndarray) else x
+
+    recipe = dict(force=force, q0=kept(q0), v0=kept(v0), t_span=t_span, method=method, h=h, steps=steps, rtol=rtol, atol=atol,
+                  events=events, dense_output=True, precision=precision, keep_complex=keep_complex,
+                  max_steps=max_steps, bits=bits)
     if t_span is None:
         raise ValueError("t_span is required")
     t0, t1 = _t_span(t_span)
@@ -321,7 +352,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.status = int(d["status"])
     res.message = d["message"]
     res.success = res.status >= 0
-    res.sol = None if d["sol"] is None else DenseSolution(d["sol"], rows, shape)
+    res.sol = None if d["sol"] is None else DenseSolution(d["sol"], rows, shape, recipe)
     if evs:
         hits = [[x for x in d["events"] if x[0] == k] for k in range(len(evs))]
         res.t_events = [np.array([x[1] for x in hs], dtype=float) for hs in hits]
