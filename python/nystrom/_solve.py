@@ -24,7 +24,8 @@ class OdeResult(dict):
     Attributes: ``t`` (output times), ``q``, ``v`` (positions and velocities, shape ``(len(t),) +
     q0.shape``), ``force_evals`` (by the method), ``output_force_evals`` (for output times, events and the
     dense output), ``steps``, ``rejected``, ``status`` (0: reached the end of t_span, 1: a terminal event,
-    -1: failure, no states returned), ``message``, ``success``, ``sol`` (a :class:`DenseSolution` when
+    -1: failure: step size underflow, too many steps or a state no longer finite; ``t``, ``q``, ``v`` then hold
+    the states saved before it), ``message``, ``success``, ``sol`` (a :class:`DenseSolution` when
     ``dense_output=True``), ``t_events``, ``q_events``, ``v_events`` (one array per event function),
     ``method``, ``precision``, ``h`` (fixed steps: the step size), ``q_str``/``v_str`` (the final state in
     full working precision, as decimal strings), ``solve_seconds`` (wall time of the library's solve() call).

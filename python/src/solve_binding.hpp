@@ -186,6 +186,7 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   // heartbeat.
   const bool release = !python_force && events.empty() && mpfr_bits == 0;
   SolveOptions opt = r.options;
+  opt.partial_on_failure = true;  // a failed run returns the states it reached, with status -1
   // Interruption checks (Ctrl-C) and progress every `every` steps: about 2^22 coordinate updates apart,
   // or every 64 steps when Python runs at every step anyway.
   const long work = static_cast<long>(m) * std::max(1, r.method.info.forces_per_step);
@@ -209,24 +210,20 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   int status = 0;
   std::string message;
   const auto start = std::chrono::steady_clock::now();
-  try {
-    if (release) {
-      py::gil_scoped_release free;
-      sol = solve(prob, r.method, opt, events);
-    } else {
-      sol = solve(prob, r.method, opt, events);
-    }
-    if (sol.status == SolveStatus::terminated_by_event) {
-      status = 1;
-      message = sol.message;
-    } else {
-      message = "The solver successfully reached the end of the integration interval.";
-    }
-  } catch (const invalid_input&) {
-    throw;
-  } catch (const nystrom::error& e) {  // step size underflow, too many steps, NaN: reported in the status
+  if (release) {
+    py::gil_scoped_release free;
+    sol = solve(prob, r.method, opt, events);
+  } else {
+    sol = solve(prob, r.method, opt, events);
+  }
+  if (sol.status == SolveStatus::terminated_by_event) {
+    status = 1;
+    message = sol.message;
+  } else if (sol.status == SolveStatus::failed) {  // step size underflow, too many steps, NaN
     status = -1;
-    message = e.what();
+    message = sol.message;
+  } else {
+    message = "The solver successfully reached the end of the integration interval.";
   }
 
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
