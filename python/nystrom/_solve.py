@@ -218,7 +218,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     h, steps : float, int
         Fixed steps: the step size (the last step ends on t1) or the number of steps over t_span.
     rtol, atol : float
-        Adaptive steps: the relative and absolute tolerances (>= 0; one alone sets both). Adaptive methods
+        Adaptive steps: the relative and absolute tolerances (>= 0, not both 0; one alone sets both;
+        rtol = 0 with atol > 0: absolute error control only). Adaptive methods
         (RKN pairs such as ``DP12-adaptive``, ``M<2n>-adaptive``, ``GBS``) take them; a multi-product method
         given a tolerance runs as its adaptive form (``M10`` as ``M10-adaptive``). Without h, steps, rtol
         and atol, adaptive methods use rtol = 1e-9.
@@ -326,8 +327,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
             rtol = atol
         elif atol is None:
             atol = 0.0
-        if not rtol > 0:
-            raise ValueError("rtol must be positive for adaptive steps")
+        if rtol == 0 and atol == 0:
+            raise ValueError("rtol and atol must not both be 0 for adaptive steps (rtol = 0: absolute control by atol)")
     evs = _events(events, from_flat)
 
     # ---- the run ---------------------------------------------------------------------------------

@@ -32,6 +32,7 @@ def one_line(exc):
     (dict(atol=-1.0, method="M8"), ValueError, "atol"),
     (dict(atol=math.nan, method="M8"), ValueError, "atol"),
     (dict(rtol=0.0, method="M8"), ValueError, "rtol"),
+    (dict(rtol=0.0, atol=0.0, method="M8"), ValueError, "must not both be 0"),
     (dict(rtol="x", method="M8"), TypeError, "rtol"),
     (dict(h=0.1, steps=10), ValueError, "either h or steps"),
     (dict(h=-0.1), ValueError, "h must be positive"),

@@ -387,3 +387,14 @@ def test_rtol_and_atol_reach_the_driver_separately():
     assert runs[1].force_evals > runs[0].force_evals
     assert kepler_error(runs[1], prob) < kepler_error(runs[0], prob)
     assert kepler_error(runs[1], prob) < 1e-9
+
+
+def test_absolute_tolerance_alone_with_rtol_zero():
+    # rtol = 0 with atol > 0: the error of every component is measured against atol alone.
+    prob = Kepler(E)
+    runs = [nystrom.solve(prob, t_span=(0, T_END), method="DP12-adaptive", rtol=0.0, atol=a, t_eval=[T_END])
+            for a in (1e-6, 1e-12)]
+    assert all(r.success for r in runs)
+    assert runs[1].force_evals > runs[0].force_evals
+    assert kepler_error(runs[1], prob) < kepler_error(runs[0], prob)
+    assert kepler_error(runs[1], prob) < 1e-9
