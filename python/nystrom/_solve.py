@@ -4,8 +4,10 @@ The integration, the output times, the dense output, the events and the step-siz
 the C++ driver; this module checks the arguments, passes them on and wraps the result.
 """
 
+import hashlib
 import math
 import numbers
+import os
 
 import numpy as np
 
@@ -28,7 +30,8 @@ class OdeResult(dict):
     the states saved before it), ``message``, ``success``, ``sol`` (a :class:`DenseSolution` when
     ``dense_output=True``), ``t_events``, ``q_events``, ``v_events`` (one array per event function),
     ``method``, ``precision``, ``h`` (fixed steps: the step size), ``q_str``/``v_str`` (the final state in
-    full working precision, as decimal strings), ``solve_seconds`` (wall time of the library's solve() call).
+    full working precision, as decimal strings), ``solve_seconds`` (wall time of the library's solve() call),
+    ``checkpoint_t`` (the time of the checkpoint written, or None).
     """
 
     def __getattr__(self, name):
@@ -196,9 +199,33 @@ def _precision(precision, bits):
     return f"mpfr:{int(bits)}"
 
 
+def _checkpoint_args(checkpoint, checkpoint_at, restart, t0, t1):
+    """(checkpoint time or NaN, checkpoint file or '', restart file or '')."""
+    if (checkpoint is None) != (checkpoint_at is None):
+        raise ValueError("checkpoint (a file) and checkpoint_at (a time) go together")
+    ck_at, ck_file, restart_file = math.nan, "", ""
+    if checkpoint is not None:
+        ck_file = os.fspath(checkpoint)
+        if isinstance(ck_file, bytes) or not ck_file:
+            raise ValueError("checkpoint must be a file name")
+        if isinstance(checkpoint_at, bool) or not isinstance(checkpoint_at, numbers.Real):
+            raise TypeError(f"checkpoint_at must be a number, got {type(checkpoint_at).__name__}")
+        ck_at = float(checkpoint_at)
+        d = 1.0 if t1 >= t0 else -1.0
+        if not (math.isfinite(ck_at) and d * (ck_at - t0) >= 0 and d * (t1 - ck_at) > 0):
+            raise ValueError(f"checkpoint_at must lie in the span, before its end, got {checkpoint_at!r}")
+    if restart is not None:
+        restart_file = os.fspath(restart)
+        if isinstance(restart_file, bytes) or not restart_file:
+            raise ValueError("restart must be a file name")
+        if restart_file == ck_file:
+            raise ValueError("checkpoint and restart name the same file")
+    return ck_at, ck_file, restart_file
+
+
 def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None, rtol=None, atol=None,
           t_eval=None, events=None, dense_output=False, precision="double", keep_complex=False,
-          progress=False, max_steps=10_000_000, bits=None):
+          progress=False, max_steps=10_000_000, bits=None, checkpoint=None, checkpoint_at=None, restart=None):
     """Integrate q'' = a(q) from (q0, v0) over t_span with a method of the catalog (the library's solve()).
 
     Parameters
@@ -245,18 +272,27 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         Adaptive steps: the most steps (accepted and rejected) of the run.
     bits : int
         precision="mpfr": the working precision in bits.
+    checkpoint, checkpoint_at : path, float
+        Write the integrator's whole state (solve/checkpoint.hpp: exact hexadecimal text) to the file
+        ``checkpoint`` at the first step boundary at or after ``checkpoint_at``, while the run goes on
+        (double and long double; ``res.checkpoint_t`` is the time it was taken).
+    restart : path
+        Continue from such a file to t_span[1], with the same problem, method and step settings (the method,
+        step settings, precision and built-in problem are checked): the result is bitwise that of the run
+        that was never interrupted.
 
     Returns
     -------
     OdeResult
     """
-    # What repeats this run for an unpickled dense output (output times and progress do not change the steps).
     def kept(x):
         return np.copy(x) if isinstance(x, np.ndarray) else x
 
-    recipe = dict(force=force, q0=kept(q0), v0=kept(v0), t_span=t_span, method=method, h=h, steps=steps, rtol=rtol, atol=atol,
-                  events=events, dense_output=True, precision=precision, keep_complex=keep_complex,
-                  max_steps=max_steps, bits=bits)
+    # What repeats this run for an unpickled dense output (output times, progress and the writing of a checkpoint
+    # do not change the steps).
+    recipe = dict(force=force, q0=kept(q0), v0=kept(v0), t_span=t_span, method=method, h=h, steps=steps,
+                  rtol=rtol, atol=atol, events=events, dense_output=True, precision=precision,
+                  keep_complex=keep_complex, max_steps=max_steps, bits=bits, restart=restart)
     if t_span is None:
         raise ValueError("t_span is required")
     t0, t1 = _t_span(t_span)
@@ -330,6 +366,17 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         if rtol == 0 and atol == 0:
             raise ValueError("rtol and atol must not both be 0 for adaptive steps (rtol = 0: absolute control by atol)")
     evs = _events(events, from_flat)
+    ck_at, ck_file, restart_file = _checkpoint_args(checkpoint, checkpoint_at, restart, t0, t1)
+    # What a checkpoint must match besides the method: the problem (its parameters and initial state) and
+    # everything that defines the steps (the end of the span only where it sets the step size).
+    start = hashlib.sha256(to_flat(q0).tobytes() + to_flat(v0).tobytes()).hexdigest()[:32]  # the initial state
+    ck_problem = " ".join([kind or "python-force", "params=" + ",".join(float(p).hex() for p in params),
+                           f"start={start}",
+                           "shape=" + "x".join(str(n) for n in shape), f"precision={precision}",
+                           f"t0={t0.hex()}", f"h={h_value.hex()}", f"steps={n_steps}"] +
+                          ([f"t1={t1.hex()}"] if n_steps else []) +
+                          [f"rtol={float(rtol).hex()}", f"atol={float(atol).hex()}",
+                           f"keep_complex={int(bool(keep_complex))}"])
 
     # ---- the run ---------------------------------------------------------------------------------
     bar = make_progress(progress, t0, t1)
@@ -337,7 +384,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         d = _core.solve(kind, params, py_force, list(shape), to_flat(q0), to_flat(v0), t0, t1, method, precision,
                         h_value, n_steps, rtol, atol, None if t_eval is None else _t_eval(t_eval, t0, t1), evs,
                         bool(dense_output), bool(keep_complex), _NO_LIMIT if fixed else int(max_steps),
-                        None if bar is None else bar.update)
+                        None if bar is None else bar.update, ck_at, ck_problem, ck_file, restart_file)
     finally:
         if bar is not None:
             bar.close()
@@ -367,5 +414,6 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.h = None if not fixed else (h_value if h_value > 0 else abs(t1 - t0) / n_steps)
     res.solve_seconds = float(d["solve_seconds"])
     res.q_str = list(d["q_str"])
+    res.checkpoint_t = d["checkpoint_t"]
     res.v_str = list(d["v_str"])
     return res
