@@ -4,11 +4,14 @@
 // Gaussian, and the Thomas-Fermi limit of the Gross-Pitaevskii chemical potential.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -255,6 +258,41 @@ TEST(QuantumSolve, BadInputIsRefused) {
   p = coherent_1d();
   p.box = -1;
   EXPECT_THROW(solve(p, "M8", 0.1, 10), std::invalid_argument);
+  p = coherent_1d();
+  p.g = std::nan("");
+  EXPECT_THROW(solve(p, "M8", 0.1, 10), std::invalid_argument);
+  p = coherent_1d();
+  p.x0 = {1, 0};  // two components in one dimension
+  EXPECT_THROW(solve(p, "M8", 0.1, 10), std::invalid_argument);
+}
+
+// The heartbeat (progress, interruption) comes every heartbeat_steps steps and once at the end; the run with it
+// differs from one without only by rounding (the unmerged sub-steps at its boundaries); an exception it throws
+// ends the run; keep_state returns the final wave function, whose norm is the result's.
+TEST(QuantumSolve, HeartbeatAndKeptState) {
+  auto p = coherent_1d();
+  p.keep_state = true;
+  const auto plain = solve(p, "Y4", 0.05, 20);
+  std::vector<std::pair<long, long>> beats;
+  p.heartbeat = [&](long done, long total) { beats.emplace_back(done, total); };
+  p.heartbeat_steps = 7;
+  const auto beaten = solve(p, "Y4", 0.05, 20);
+  EXPECT_EQ(beats, (std::vector<std::pair<long, long>>{{7, 20}, {14, 20}, {20, 20}}));
+  ASSERT_EQ(beaten.psi.size(), 64u);
+  ASSERT_EQ(plain.psi.size(), 64u);
+  double norm = 0, diff = 0;
+  for (std::size_t i = 0; i < 64; ++i) {
+    norm += std::norm(beaten.psi[i]) * (20.0 / 64);
+    diff = std::max(diff, std::abs(beaten.psi[i] - plain.psi[i]));
+  }
+  EXPECT_NEAR(norm, beaten.norm, 1e-13);
+  EXPECT_LT(diff, 1e-13);
+  p.heartbeat = [](long done, long) {
+    if (done >= 7) throw std::runtime_error("stop");
+  };
+  EXPECT_THROW(solve(p, "Y4", 0.05, 20), std::runtime_error);
+  p.heartbeat_steps = 0;
+  EXPECT_THROW(solve(p, "Y4", 0.05, 20), std::invalid_argument);
 }
 
 // Chin's forward method 4A: every coefficient positive, the middle potential sub-step modified by the gradient

@@ -227,6 +227,27 @@ TEST(Solve, AForceReturningNaNIsReportedWithTheTime) {
   }
 }
 
+TEST(Solve, AFailedRunReturnsTheStatesItReachedWhenAsked) {
+  // SolveOptions::partial_on_failure: the failures above end the run with status failed, the error's message
+  // and the states saved before it: q = t^2/2 (a constant force, integrated exactly up to rounding) for t <= 1.
+  VdForce f = [](const Vd& q, Vd& a) { a[0] = q[0] > 0.5 ? NAN : 1.0; };
+  const SecondOrderProblem prob(f, Vd{0.0}, Vd{0.0}, 0.0, 2.0);
+  for (const std::string m : {"DP12-adaptive", "VV"}) {
+    SCOPED_TRACE(m);
+    SolveOptions opt = m == "VV" ? SolveOptions{.steps = 100} : SolveOptions{.rtol = 1e-10};
+    opt.partial_on_failure = true;
+    const auto sol = solve(prob, m, opt);
+    EXPECT_EQ(sol.status, SolveStatus::failed);
+    EXPECT_NE(sol.message.find("NaN"), std::string::npos) << sol.message;
+    ASSERT_GE(sol.t.size(), 2u);
+    EXPECT_LE(sol.t.back(), 1.0 + 1e-12);
+    EXPECT_GT(sol.t.back(), 0.9);  // VV: the step end 1.0 before the failing one; DP12: steps shrunk towards 1
+    for (std::size_t i = 0; i < sol.t.size(); ++i) EXPECT_NEAR(sol.q[i][0], sol.t[i] * sol.t[i] / 2, 1e-12);
+    EXPECT_EQ(sol.t_final, sol.t.back());
+    EXPECT_EQ(sol.q_final, sol.q.back());
+  }
+}
+
 namespace {
 
 // How far the located time of a zero of g = r.v (a pericentre or apocentre of Kepler) may lie from the

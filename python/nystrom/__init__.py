@@ -5,20 +5,21 @@
                         t_span=(0, 20 * np.pi), method="M8", steps=20000)
     res.q[-1], res.force_evals
 
-Built-in problems (``nystrom.problems``) run in C++ with the GIL released; ``nystrom.ensemble`` maps runs
-over a process pool, a Dask client or an MPI pool; ``nystrom.plot`` draws orbits, energy errors and
-work-precision charts.
+Built-in problems (``nystrom.problems``) and the split-operator Schrödinger solver (``nystrom.quantum``) run
+in C++ with the GIL released; ``nystrom.ensemble`` maps runs over a process pool, a Dask client or an MPI
+pool; ``nystrom.plot`` draws orbits, energy errors and work-precision charts.
 """
 
 import json
 
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
+from ._quantum import QuantumResult, quantum
 from .ensemble import ensemble
 from . import problems
 
-__all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "problems", "ensemble",
-           "plot"]
+__all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
+           "problems", "ensemble", "plot"]
 
 
 def methods():

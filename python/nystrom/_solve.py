@@ -4,8 +4,10 @@ The integration, the output times, the dense output, the events and the step-siz
 the C++ driver; this module checks the arguments, passes them on and wraps the result.
 """
 
+import hashlib
 import math
 import numbers
+import os
 
 import numpy as np
 
@@ -24,10 +26,12 @@ class OdeResult(dict):
     Attributes: ``t`` (output times), ``q``, ``v`` (positions and velocities, shape ``(len(t),) +
     q0.shape``), ``force_evals`` (by the method), ``output_force_evals`` (for output times, events and the
     dense output), ``steps``, ``rejected``, ``status`` (0: reached the end of t_span, 1: a terminal event,
-    -1: failure, no states returned), ``message``, ``success``, ``sol`` (a :class:`DenseSolution` when
+    -1: failure: step size underflow, too many steps or a state no longer finite; ``t``, ``q``, ``v`` then hold
+    the states saved before it), ``message``, ``success``, ``sol`` (a :class:`DenseSolution` when
     ``dense_output=True``), ``t_events``, ``q_events``, ``v_events`` (one array per event function),
     ``method``, ``precision``, ``h`` (fixed steps: the step size), ``q_str``/``v_str`` (the final state in
-    full working precision, as decimal strings), ``solve_seconds`` (wall time of the library's solve() call).
+    full working precision, as decimal strings), ``solve_seconds`` (wall time of the library's solve() call),
+    ``checkpoint_t`` (the time of the checkpoint written, or None).
     """
 
     def __getattr__(self, name):
@@ -51,20 +55,39 @@ class DenseSolution:
     """``sol(t) -> (q, v)``: the state at any t of the integrated span, continued from the step end before t
     by one step of the solution's own method (the library's dense output), so with the method's accuracy;
     each time costs one step's force evaluations. For an array of times the leading axis runs over the
-    times."""
+    times.
 
-    def __init__(self, core, rows, shape):
+    It pickles (so that it comes back from an ensemble's worker processes) as the arguments of the run that
+    made it: the method's engine and the force it continues with are compiled code, so the unpickled copy
+    repeats that run (deterministic, so sol(t) is bitwise the same) at its first use. The force and the
+    event functions must then be picklable (module-level functions or built-in problems)."""
+
+    def __init__(self, core, rows, shape, recipe=None):
         self._core = core
         self._rows = rows
         self._shape = tuple(shape)
+        self._recipe = recipe
+
+    def _built(self):
+        if self._core is None:
+            other = solve(**self._recipe).sol
+            self._core, self._rows = other._core, other._rows
+        return self._core
+
+    def __reduce__(self):
+        if self._recipe is None:
+            raise TypeError("this DenseSolution cannot be pickled: its run's arguments were not kept")
+        return (_dense_from_recipe, (self._recipe, self._shape))
 
     @property
     def t_min(self):
-        return min(self._core.t_first, self._core.t_last)
+        core = self._built()
+        return min(core.t_first, core.t_last)
 
     @property
     def t_max(self):
-        return max(self._core.t_first, self._core.t_last)
+        core = self._built()
+        return max(core.t_first, core.t_last)
 
     def __call__(self, t):
         ts = np.asarray(t, dtype=float)
@@ -72,11 +95,16 @@ class DenseSolution:
         ts = np.ascontiguousarray(ts.reshape(-1))
         if not np.all(np.isfinite(ts)):
             raise ValueError("sol(t): times must be finite")
-        q, v = self._core(ts)
+        q, v = self._built()(ts)
         q, v = self._rows(q), self._rows(v)
         if scalar:
             return q[0], v[0]
         return q, v
+
+
+def _dense_from_recipe(recipe, shape):
+    """An unpickled DenseSolution: the run is repeated at its first use."""
+    return DenseSolution(None, None, shape, recipe)
 
 
 def _positive(name, x):
@@ -171,9 +199,33 @@ def _precision(precision, bits):
     return f"mpfr:{int(bits)}"
 
 
+def _checkpoint_args(checkpoint, checkpoint_at, restart, t0, t1):
+    """(checkpoint time or NaN, checkpoint file or '', restart file or '')."""
+    if (checkpoint is None) != (checkpoint_at is None):
+        raise ValueError("checkpoint (a file) and checkpoint_at (a time) go together")
+    ck_at, ck_file, restart_file = math.nan, "", ""
+    if checkpoint is not None:
+        ck_file = os.fspath(checkpoint)
+        if isinstance(ck_file, bytes) or not ck_file:
+            raise ValueError("checkpoint must be a file name")
+        if isinstance(checkpoint_at, bool) or not isinstance(checkpoint_at, numbers.Real):
+            raise TypeError(f"checkpoint_at must be a number, got {type(checkpoint_at).__name__}")
+        ck_at = float(checkpoint_at)
+        d = 1.0 if t1 >= t0 else -1.0
+        if not (math.isfinite(ck_at) and d * (ck_at - t0) >= 0 and d * (t1 - ck_at) > 0):
+            raise ValueError(f"checkpoint_at must lie in the span, before its end, got {checkpoint_at!r}")
+    if restart is not None:
+        restart_file = os.fspath(restart)
+        if isinstance(restart_file, bytes) or not restart_file:
+            raise ValueError("restart must be a file name")
+        if restart_file == ck_file:
+            raise ValueError("checkpoint and restart name the same file")
+    return ck_at, ck_file, restart_file
+
+
 def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None, rtol=None, atol=None,
           t_eval=None, events=None, dense_output=False, precision="double", keep_complex=False,
-          progress=False, max_steps=10_000_000, bits=None):
+          progress=False, max_steps=10_000_000, bits=None, checkpoint=None, checkpoint_at=None, restart=None):
     """Integrate q'' = a(q) from (q0, v0) over t_span with a method of the catalog (the library's solve()).
 
     Parameters
@@ -193,7 +245,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     h, steps : float, int
         Fixed steps: the step size (the last step ends on t1) or the number of steps over t_span.
     rtol, atol : float
-        Adaptive steps: the relative and absolute tolerances (>= 0; one alone sets both). Adaptive methods
+        Adaptive steps: the relative and absolute tolerances (>= 0, not both 0; one alone sets both;
+        rtol = 0 with atol > 0: absolute error control only). Adaptive methods
         (RKN pairs such as ``DP12-adaptive``, ``M<2n>-adaptive``, ``GBS``) take them; a multi-product method
         given a tolerance runs as its adaptive form (``M10`` as ``M10-adaptive``). Without h, steps, rtol
         and atol, adaptive methods use rtol = 1e-9.
@@ -219,11 +272,27 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         Adaptive steps: the most steps (accepted and rejected) of the run.
     bits : int
         precision="mpfr": the working precision in bits.
+    checkpoint, checkpoint_at : path, float
+        Write the integrator's whole state (solve/checkpoint.hpp: exact hexadecimal text) to the file
+        ``checkpoint`` at the first step boundary at or after ``checkpoint_at``, while the run goes on
+        (double and long double; ``res.checkpoint_t`` is the time it was taken).
+    restart : path
+        Continue from such a file to t_span[1], with the same problem, method and step settings (the method,
+        step settings, precision and built-in problem are checked): the result is bitwise that of the run
+        that was never interrupted.
 
     Returns
     -------
     OdeResult
     """
+    def kept(x):
+        return np.copy(x) if isinstance(x, np.ndarray) else x
+
+    # What repeats this run for an unpickled dense output (output times, progress and the writing of a checkpoint
+    # do not change the steps).
+    recipe = dict(force=force, q0=kept(q0), v0=kept(v0), t_span=t_span, method=method, h=h, steps=steps,
+                  rtol=rtol, atol=atol, events=events, dense_output=True, precision=precision,
+                  keep_complex=keep_complex, max_steps=max_steps, bits=bits, restart=restart)
     if t_span is None:
         raise ValueError("t_span is required")
     t0, t1 = _t_span(t_span)
@@ -294,9 +363,20 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
             rtol = atol
         elif atol is None:
             atol = 0.0
-        if not rtol > 0:
-            raise ValueError("rtol must be positive for adaptive steps")
+        if rtol == 0 and atol == 0:
+            raise ValueError("rtol and atol must not both be 0 for adaptive steps (rtol = 0: absolute control by atol)")
     evs = _events(events, from_flat)
+    ck_at, ck_file, restart_file = _checkpoint_args(checkpoint, checkpoint_at, restart, t0, t1)
+    # What a checkpoint must match besides the method: the problem (its parameters and initial state) and
+    # everything that defines the steps (the end of the span only where it sets the step size).
+    start = hashlib.sha256(to_flat(q0).tobytes() + to_flat(v0).tobytes()).hexdigest()[:32]  # the initial state
+    ck_problem = " ".join([kind or "python-force", "params=" + ",".join(float(p).hex() for p in params),
+                           f"start={start}",
+                           "shape=" + "x".join(str(n) for n in shape), f"precision={precision}",
+                           f"t0={t0.hex()}", f"h={h_value.hex()}", f"steps={n_steps}"] +
+                          ([f"t1={t1.hex()}"] if n_steps else []) +
+                          [f"rtol={float(rtol).hex()}", f"atol={float(atol).hex()}",
+                           f"keep_complex={int(bool(keep_complex))}"])
 
     # ---- the run ---------------------------------------------------------------------------------
     bar = make_progress(progress, t0, t1)
@@ -304,7 +384,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         d = _core.solve(kind, params, py_force, list(shape), to_flat(q0), to_flat(v0), t0, t1, method, precision,
                         h_value, n_steps, rtol, atol, None if t_eval is None else _t_eval(t_eval, t0, t1), evs,
                         bool(dense_output), bool(keep_complex), _NO_LIMIT if fixed else int(max_steps),
-                        None if bar is None else bar.update)
+                        None if bar is None else bar.update, ck_at, ck_problem, ck_file, restart_file)
     finally:
         if bar is not None:
             bar.close()
@@ -321,7 +401,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.status = int(d["status"])
     res.message = d["message"]
     res.success = res.status >= 0
-    res.sol = None if d["sol"] is None else DenseSolution(d["sol"], rows, shape)
+    res.sol = None if d["sol"] is None else DenseSolution(d["sol"], rows, shape, recipe)
     if evs:
         hits = [[x for x in d["events"] if x[0] == k] for k in range(len(evs))]
         res.t_events = [np.array([x[1] for x in hs], dtype=float) for hs in hits]
@@ -334,5 +414,6 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.h = None if not fixed else (h_value if h_value > 0 else abs(t1 - t0) / n_steps)
     res.solve_seconds = float(d["solve_seconds"])
     res.q_str = list(d["q_str"])
+    res.checkpoint_t = d["checkpoint_t"]
     res.v_str = list(d["v_str"])
     return res

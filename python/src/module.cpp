@@ -25,6 +25,9 @@
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/plummer.hpp"
 #include "solve_binding.hpp"
+#ifdef NYSTROM_PYTHON_QUANTUM
+#include "quantum_binding.hpp"
+#endif
 
 namespace py = pybind11;
 using namespace nystrom;
@@ -251,7 +254,8 @@ PYBIND11_MODULE(_core, m) {
          std::vector<py::ssize_t> shape, const DArray& q0, const DArray& v0, double t0, double t1,
          const std::string& method, const std::string& precision, double h, long steps, double rtol, double atol,
          std::optional<std::vector<double>> t_eval, const py::list& events, bool dense, bool keep_complex,
-         long max_steps, py::object progress) {
+         long max_steps, py::object progress, double checkpoint_at, std::string checkpoint_problem,
+         std::string checkpoint_file, std::string restart_file) {
         SolveRequest r;
         r.method = solve_method(method, rtol > 0 || atol > 0);
         r.q0 = flat(q0);
@@ -272,6 +276,10 @@ PYBIND11_MODULE(_core, m) {
           r.events.push_back({t[0], t[1].cast<int>(), t[2].cast<bool>(), t[3].cast<std::string>()});
         }
         r.progress = std::move(progress);
+        r.checkpoint_at = checkpoint_at;
+        r.checkpoint_problem = std::move(checkpoint_problem);
+        r.checkpoint_file = std::move(checkpoint_file);
+        r.restart_file = std::move(restart_file);
         if (problem.empty()) {
           if (precision != "double")
             throw invalid_input("precision '" + precision + "' is available for built-in problems only");
@@ -283,7 +291,12 @@ PYBIND11_MODULE(_core, m) {
       py::arg("problem"), py::arg("params"), py::arg("force"), py::arg("shape"), py::arg("q0"), py::arg("v0"),
       py::arg("t0"), py::arg("t1"), py::arg("method"), py::arg("precision"), py::arg("h"), py::arg("steps"),
       py::arg("rtol"), py::arg("atol"), py::arg("t_eval"), py::arg("events"), py::arg("dense"), py::arg("keep_complex"),
-      py::arg("max_steps"), py::arg("progress"),
+      py::arg("max_steps"), py::arg("progress"), py::arg("checkpoint_at"), py::arg("checkpoint_problem"),
+      py::arg("checkpoint_file"), py::arg("restart_file"),
       "solve() (nystrom/solve.hpp) on a built-in problem (problem: its name) or a Python force(t, q) "
       "(problem: ''); nystrom.solve checks the arguments and wraps the result.");
+
+#ifdef NYSTROM_PYTHON_QUANTUM
+  register_quantum(m);
+#endif
 }

@@ -17,6 +17,7 @@
 #include <complex>
 #include <cstddef>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -47,6 +48,11 @@ struct SolveRequest {
   SolveOptions options;  // h or steps, rtol and atol, t_eval, dense, max_steps, engine options
   std::vector<PyEvent> events;
   py::object progress = py::none();  // None or progress(t)
+  /// Checkpoint (solve/checkpoint.hpp): written to checkpoint_file at the first step boundary at or after
+  /// checkpoint_at while the run goes on; restart_file: continue from such a file. checkpoint_problem: what
+  /// a checkpoint must match besides the method.
+  double checkpoint_at = std::numeric_limits<double>::quiet_NaN();
+  std::string checkpoint_problem, checkpoint_file, restart_file;
 };
 
 /// sol(t) of a finished run, whatever its state type: flat states of n coordinates as doubles.
@@ -186,6 +192,7 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   // heartbeat.
   const bool release = !python_force && events.empty() && mpfr_bits == 0;
   SolveOptions opt = r.options;
+  opt.partial_on_failure = true;  // a failed run returns the states it reached, with status -1
   // Interruption checks (Ctrl-C) and progress every `every` steps: about 2^22 coordinate updates apart,
   // or every 64 steps when Python runs at every step anyway.
   const long work = static_cast<long>(m) * std::max(1, r.method.info.forces_per_step);
@@ -205,28 +212,47 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
     }
   };
 
+  opt.checkpoint_at = r.checkpoint_at;
+  opt.checkpoint_problem = r.checkpoint_problem;
+  std::optional<Checkpoint<R>> from;
+  if constexpr (checkpoint_detail::exact_text<R>) {
+    if (!r.checkpoint_file.empty())
+      opt.on_checkpoint = [file = r.checkpoint_file](const std::string& text) {
+        try {
+          write_checkpoint_text(file, text);
+        } catch (const nystrom::error& e) {  // a bad path is bad input, not a failure of the integration
+          throw invalid_input(e.what());
+        }
+      };
+    if (!r.restart_file.empty()) {
+      from = read_checkpoint<R>(r.restart_file);
+      if (prob.t1 >= prob.t0 ? from->t > prob.t1 : from->t < prob.t1)
+        throw invalid_input("the checkpoint lies after the end of the span");
+    }
+  } else {
+    if (!r.checkpoint_file.empty() || !r.restart_file.empty())
+      throw invalid_input("checkpoints are written for double and long double states");
+  }
+
   Solution<V> sol;
   int status = 0;
   std::string message;
   const auto start = std::chrono::steady_clock::now();
-  try {
-    if (release) {
-      py::gil_scoped_release free;
-      sol = solve(prob, r.method, opt, events);
-    } else {
-      sol = solve(prob, r.method, opt, events);
-    }
-    if (sol.status == SolveStatus::terminated_by_event) {
-      status = 1;
-      message = sol.message;
-    } else {
-      message = "The solver successfully reached the end of the integration interval.";
-    }
-  } catch (const invalid_input&) {
-    throw;
-  } catch (const nystrom::error& e) {  // step size underflow, too many steps, NaN: reported in the status
+  auto run = [&] { return from ? resume(prob, r.method, *from, opt, events) : solve(prob, r.method, opt, events); };
+  if (release) {
+    py::gil_scoped_release free;
+    sol = run();
+  } else {
+    sol = run();
+  }
+  if (sol.status == SolveStatus::terminated_by_event) {
+    status = 1;
+    message = sol.message;
+  } else if (sol.status == SolveStatus::failed) {  // step size underflow, too many steps, NaN
     status = -1;
-    message = e.what();
+    message = sol.message;
+  } else {
+    message = "The solver successfully reached the end of the integration interval.";
   }
 
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -265,6 +291,7 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   d["rejected"] = sol.rejected;
   d["status"] = status;
   d["message"] = message;
+  d["checkpoint_t"] = sol.checkpoint ? py::object(py::float_(as_double(sol.checkpoint->t))) : py::object(py::none());
   if (opt.dense && status >= 0 && !sol.dense.empty())
     d["sol"] = py::cast(std::unique_ptr<DenseSolution>(new DenseSolutionOf<V>(std::move(sol), n, mpfr_bits)));
   else

@@ -32,6 +32,7 @@ def one_line(exc):
     (dict(atol=-1.0, method="M8"), ValueError, "atol"),
     (dict(atol=math.nan, method="M8"), ValueError, "atol"),
     (dict(rtol=0.0, method="M8"), ValueError, "rtol"),
+    (dict(rtol=0.0, atol=0.0, method="M8"), ValueError, "must not both be 0"),
     (dict(rtol="x", method="M8"), TypeError, "rtol"),
     (dict(h=0.1, steps=10), ValueError, "either h or steps"),
     (dict(h=-0.1), ValueError, "h must be positive"),
@@ -93,18 +94,47 @@ def test_force_exception_propagates_unchanged():
         assert calls[0] == 7
 
 
-def test_nan_during_the_integration_is_reported():
-    # a = q^3 blows up in finite time: the run stops with status -1 and a message, no garbage.
-    res = nystrom.solve(lambda t, q: q ** 3 * 1e3, [10.0], [10.0], t_span=(0, 10.0), method="FR", steps=1000)
+def blow_up(t, q):
+    with np.errstate(over="ignore", invalid="ignore"):
+        return q ** 3
+
+
+def test_nan_during_the_integration_is_reported_with_the_states_before_it():
+    # a = q^3 blows up in finite time (near t = 1.3 from q = v = 1): the run stops with status -1 and a message,
+    # no garbage; the states saved before the failure are those of a run that stops earlier (the same steps).
+    res = nystrom.solve(blow_up, [1.0], [1.0], t_span=(0, 10.0), method="FR", steps=1000)
     assert res.status == -1 and not res.success
     assert "NaN" in res.message
+    k = len(res.t)
+    assert k >= 50 and res.q.shape == (k, 1) and res.v.shape == (k, 1)
+    assert np.all(np.isfinite(res.q)) and np.all(np.isfinite(res.v)) and res.t[-1] < 10.0
+    assert np.allclose(res.t, 0.01 * np.arange(k), rtol=0, atol=1e-12)
+    ok = nystrom.solve(blow_up, [1.0], [1.0], t_span=(0, res.t[-1]), method="FR", steps=k - 1)
+    assert ok.success and np.allclose(ok.q, res.q, rtol=1e-12, atol=0) and np.allclose(ok.v, res.v, rtol=1e-12, atol=0)
 
 
-def test_adaptive_failure_is_reported_in_status():
-    # An orbit that falls into the centre (zero angular momentum): the step size underflows.
+def test_adaptive_failure_is_reported_in_status_with_the_states_before_it():
+    # An orbit that falls into the centre (zero angular momentum): the step size underflows; the states
+    # returned fall in towards the centre until then.
     res = nystrom.solve(Kepler(0.0), q0=[1.0, 0.0], v0=[0.0, 0.0], t_span=(0, 10.0), method="DP12-adaptive",
                         rtol=1e-12)
     assert res.status == -1 and "underflow" in res.message
+    r = np.linalg.norm(res.q, axis=1)
+    assert len(res.t) > 2 and r[0] == 1.0 and np.all(np.diff(r) < 0) and np.all(np.diff(res.t) > 0)
+    # radial infall from rest at r = 1 reaches the centre at t = pi / (2 sqrt 2) (Kepler's third law)
+    assert res.t[-1] <= math.pi / (2 * math.sqrt(2))
+    assert np.all(np.isfinite(res.q)) and np.all(np.isfinite(res.v))
+
+
+def test_too_many_steps_returns_the_prefix_of_the_full_run():
+    prob = Kepler(0.5)
+    full = nystrom.solve(prob, t_span=(0, 20.0), method="DP12-adaptive", rtol=1e-10)
+    cut = nystrom.solve(prob, t_span=(0, 20.0), method="DP12-adaptive", rtol=1e-10, max_steps=20)
+    assert full.success and cut.status == -1 and "steps" in cut.message
+    k = len(cut.t)
+    assert 2 <= k <= 21 and k < len(full.t)
+    assert np.array_equal(cut.t, full.t[:k]) and np.array_equal(cut.q, full.q[:k]) and np.array_equal(cut.v, full.v[:k])
+    assert cut.sol is None and cut.q_str == []
 
 
 def test_problem_arguments():

@@ -1,6 +1,7 @@
 """GIL release, Ctrl-C, progress, and ensembles over a process pool, threads, Dask and MPI."""
 import json
 import os
+import pickle
 import shutil
 import signal
 import subprocess
@@ -147,3 +148,47 @@ def test_ensemble_over_mpi(reference, tmp_path, child_env):
     for (q, v, evals), ref in zip(got, reference):
         assert np.array_equal(np.array(q), ref.q) and np.array_equal(np.array(v), ref.v)
         assert evals == ref.force_evals
+
+
+# ---- dense output through pickle and ensembles -------------------------------------------------------
+
+def kepler_force(t, q):
+    return -q / np.dot(q, q) ** 1.5
+
+
+DENSE_TIMES = np.linspace(0.0, 20.0, 37) + 0.01 * np.sin(np.arange(37))  # between the step ends
+
+
+@pytest.mark.parametrize("python_force", [False, True])
+def test_dense_output_pickles_and_evaluates_bitwise(python_force):
+    prob = Kepler(0.6)
+    if python_force:
+        res = nystrom.solve(kepler_force, prob.q0, prob.v0, t_span=(0, 20.5), method="DP12-adaptive", rtol=1e-10,
+                            dense_output=True)
+    else:
+        res = nystrom.solve(prob, t_span=(0, 20.5), method="M8", steps=3000, dense_output=True)
+    back = pickle.loads(pickle.dumps(res))
+    q, v = res.sol(DENSE_TIMES)
+    q2, v2 = back.sol(DENSE_TIMES)
+    assert np.array_equal(q, q2) and np.array_equal(v, v2)
+    assert back.sol.t_min == res.sol.t_min and back.sol.t_max == res.sol.t_max
+    assert np.allclose(q, prob.exact(DENSE_TIMES)[0], rtol=0, atol=1e-6)
+
+
+def test_dense_output_of_an_unpicklable_force_refuses_to_pickle():
+    prob = Kepler(0.6)
+    res = nystrom.solve(lambda t, q: -q / np.dot(q, q) ** 1.5, prob.q0, prob.v0, t_span=(0, 1.0), steps=10,
+                        dense_output=True)
+    with pytest.raises((pickle.PicklingError, AttributeError, TypeError)):
+        pickle.dumps(res)
+
+
+def test_ensemble_with_dense_output_matches_a_serial_run():
+    args = dict(t_span=(0, 20.0), steps=2000, dense_output=True)
+    serial = [nystrom.solve(Kepler(e), method="M8", **args) for e in ECCS]
+    pooled = nystrom.ensemble(make_kepler, ECCS, method="M8", max_workers=2, **args)
+    for a, b in zip(serial, pooled):
+        assert np.array_equal(a.q, b.q)
+        qa, va = a.sol(DENSE_TIMES)
+        qb, vb = b.sol(DENSE_TIMES)
+        assert np.array_equal(qa, qb) and np.array_equal(va, vb)

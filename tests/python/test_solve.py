@@ -387,3 +387,58 @@ def test_rtol_and_atol_reach_the_driver_separately():
     assert runs[1].force_evals > runs[0].force_evals
     assert kepler_error(runs[1], prob) < kepler_error(runs[0], prob)
     assert kepler_error(runs[1], prob) < 1e-9
+
+
+def test_absolute_tolerance_alone_with_rtol_zero():
+    # rtol = 0 with atol > 0: the error of every component is measured against atol alone.
+    prob = Kepler(E)
+    runs = [nystrom.solve(prob, t_span=(0, T_END), method="DP12-adaptive", rtol=0.0, atol=a, t_eval=[T_END])
+            for a in (1e-6, 1e-12)]
+    assert all(r.success for r in runs)
+    assert runs[1].force_evals > runs[0].force_evals
+    assert kepler_error(runs[1], prob) < kepler_error(runs[0], prob)
+    assert kepler_error(runs[1], prob) < 1e-9
+
+
+# ---- checkpoints ---------------------------------------------------------------------------------------
+
+CHECKPOINT_RUNS = [dict(method="M8", steps=2000), dict(method="DP12-adaptive", rtol=1e-11),
+                   dict(method="M10-adaptive", rtol=1e-11), dict(method="GBS", rtol=1e-11)]
+
+
+@pytest.mark.parametrize("python_force", [False, True])
+@pytest.mark.parametrize("kw", CHECKPOINT_RUNS)
+def test_restart_from_a_checkpoint_is_bitwise_the_uninterrupted_run(tmp_path, kw, python_force):
+    prob = Kepler(E)
+    args = (kepler_force, prob.q0, prob.v0) if python_force else (prob,)
+    path = tmp_path / "run.checkpoint"
+    full = nystrom.solve(*args, t_span=(0, 20.0), checkpoint=path, checkpoint_at=7.0, **kw)
+    assert full.success and 7.0 <= full.checkpoint_t < 20.0 and path.exists()
+    again = nystrom.solve(*args, t_span=(0, 20.0), restart=path, **kw)
+    assert again.success and again.t[0] == full.checkpoint_t
+    k = int(np.searchsorted(full.t, full.checkpoint_t))
+    assert np.array_equal(again.t, full.t[k:])
+    assert np.array_equal(again.q, full.q[k:]) and np.array_equal(again.v, full.v[k:])
+    assert again.q_str == full.q_str and again.v_str == full.v_str
+
+
+def test_checkpoint_mismatches_and_bad_files_are_refused(tmp_path):
+    prob = Kepler(E)
+    path = tmp_path / "run.checkpoint"
+    nystrom.solve(prob, t_span=(0, 20.0), method="M8", steps=2000, checkpoint=path, checkpoint_at=7.0)
+    cases = [
+        (dict(method="M6", steps=2000, restart=path), "method"),
+        (dict(method="M8", steps=1000, restart=path), "another problem"),
+        (dict(method="M8", steps=2000, restart=tmp_path / "missing"), "cannot read"),
+        (dict(method="M8", steps=2000, checkpoint=path), "go together"),
+        (dict(method="M8", steps=2000, checkpoint=tmp_path / "no" / "dir", checkpoint_at=1.0), "cannot write"),
+        (dict(method="M8", steps=2000, checkpoint=path, checkpoint_at=25.0), "checkpoint_at"),
+        (dict(method="M8", steps=2000, checkpoint=path, checkpoint_at=1.0, restart=path), "same file"),
+        (dict(method="M8", steps=2000, checkpoint=tmp_path / "dd", checkpoint_at=1.0, precision="dd"),
+         "double and long double"),
+    ]
+    for kw, match in cases:
+        with pytest.raises(ValueError, match=match):
+            nystrom.solve(prob, t_span=(0, 20.0), **kw)
+    with pytest.raises(ValueError, match="another problem"):
+        nystrom.solve(Kepler(0.3), t_span=(0, 20.0), method="M8", steps=2000, restart=path)

@@ -3,6 +3,7 @@
 // FFT count and, where one exists, the error against the exact solution.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -49,6 +50,14 @@ struct QuantumProblem {
   /// quantum/fftw_mpi.hpp spreads the grid over MPI ranks (then solve() is collective and every rank gets the
   /// result of the whole grid).
   std::function<std::unique_ptr<FftTransforms<R>>(const Grid<R>&, const FftOptions&)> transforms;
+  /// Keep the final wave function in QuantumResult::psi (the points this process holds).
+  bool keep_state = false;
+  /// When set, called as heartbeat(done, total) after every `heartbeat_steps` steps (total: steps times
+  /// states), e.g. to report progress or to stop the run by throwing. A heartbeat ends a call of the
+  /// integrator, so a splitting's last sub-step is not merged with the next step's first there: the result
+  /// differs from a run without heartbeat in the last bits.
+  std::function<void(long done, long total)> heartbeat;
+  long heartbeat_steps = 0;
 };
 
 /// Observables at one time.
@@ -72,6 +81,7 @@ struct QuantumResult {
   long fft_count = 0;
   double seconds = 0;
   std::vector<QuantumSample> samples;
+  std::vector<std::complex<double>> psi;  // the final wave function, when QuantumProblem::keep_state is set
 };
 
 namespace detail {
@@ -102,9 +112,15 @@ QuantumResult solve(const QuantumProblem<R>& p, const std::string& method, R dt,
   if (p.states > 1 && (p.time != TimeKind::imaginary || p.g != 0))
     throw std::invalid_argument("excited states need imaginary time and g = 0");
   detail::check_positive_finite(static_cast<double>(p.width), "the initial width");
+  if (!std::isfinite(static_cast<double>(p.g))) throw std::invalid_argument("g must be finite");
+  if (p.heartbeat && p.heartbeat_steps < 1) throw std::invalid_argument("heartbeat_steps must be positive");
   for (const auto& v : {p.x0, p.p0})
     for (R x : v)
       if (!std::isfinite(static_cast<double>(x))) throw std::invalid_argument("x0 and p0 must be finite");
+  for (const auto* v : {&p.x0, &p.p0})
+    if (static_cast<int>(v->size()) > p.dims)
+      throw std::invalid_argument(std::string(v == &p.x0 ? "x0" : "p0") + " has " + std::to_string(v->size()) +
+                                  " components for " + std::to_string(p.dims) + " dimension(s)");
   const Grid<R> grid(p.dims, p.grid, p.box);
   const operators::FlowMethod fm = operators::resolve_flow_method(method, operators::OperatorStructure::rkn,
                                                                   scalar_traits<R>::bits(), scalar_traits<R>::name());
@@ -158,18 +174,34 @@ QuantumResult solve(const QuantumProblem<R>& p, const std::string& method, R dt,
     s.autocorrelation = autocorrelation();
     r.samples.push_back(std::move(s));
   };
+  const long total = steps * p.states;
+  long beaten = 0;  // steps done over all states, for the heartbeat
+  // n steps of phi, in calls of at most heartbeat_steps steps with a heartbeat after each
+  auto advance = [&](Field<R>& phi, long n) {
+    if (!p.heartbeat) {
+      integ.integrate(flows, phi, dt, n);
+      return;
+    }
+    while (n > 0) {
+      const long k = std::min(n, p.heartbeat_steps);
+      integ.integrate(flows, phi, dt, k);
+      n -= k;
+      beaten += k;
+      p.heartbeat(beaten, total);
+    }
+  };
   const auto t0 = std::chrono::steady_clock::now();
   if (samples > 0) {
     record(0);
     long done = 0;
     for (long i = 1; i <= samples; ++i) {
       const long target = steps * i / samples;
-      integ.integrate(flows, psi, dt, target - done);
+      advance(psi, target - done);
       done = target;
       record(done);
     }
   } else {
-    integ.integrate(flows, psi, dt, steps);
+    advance(psi, steps);
   }
   r.autocorrelation = autocorrelation();
   const auto o = observe(flows, psi);
@@ -193,6 +225,7 @@ QuantumResult solve(const QuantumProblem<R>& p, const std::string& method, R dt,
     for (long i = 0; i < steps; ++i) {
       integ.integrate(flows, phi, dt, 1);
       orthogonalise();
+      if (p.heartbeat && (++beaten % p.heartbeat_steps == 0 || i + 1 == steps)) p.heartbeat(beaten, total);
     }
     r.energies.push_back(static_cast<double>(observe(flows, phi).energy));
     lower.push_back(std::move(phi));
@@ -206,6 +239,8 @@ QuantumResult solve(const QuantumProblem<R>& p, const std::string& method, R dt,
   r.chemical_potential = static_cast<double>(o.chemical_potential);
   for (R x : o.mean_x) r.mean_x.push_back(static_cast<double>(x));
   for (R x : o.mean_p) r.mean_p.push_back(static_cast<double>(x));
+  if (p.keep_state)
+    for (const auto& z : psi) r.psi.emplace_back(static_cast<double>(z.real()), static_cast<double>(z.imag()));
   if (!std::isfinite(r.norm) || !std::isfinite(r.energy))
     throw std::runtime_error("the wave function blew up (norm or energy not finite): '" + r.method +
                              "' is unstable for this problem and step");

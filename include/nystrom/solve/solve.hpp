@@ -90,6 +90,10 @@ struct SolveOptions {
   /// Called at every accepted step end with its time, if set (a progress display, an interruption
   /// check); an exception it throws ends the run and leaves solve() unchanged.
   std::function<void(double t)> on_step{};
+  /// When a run fails (step_size_underflow, too_many_steps, a state no longer finite: a nystrom::error
+  /// other than invalid_input), return what it reached instead of throwing: the saved states up to the
+  /// failure (every step end, or the output times passed), status `failed` and the error's message.
+  bool partial_on_failure = false;
 };
 
 /// An event function g(t, q, v): its zeros are located (direction: +1 rising only, -1 falling only,
@@ -112,14 +116,14 @@ struct EventHit {
   V q, v;
 };
 
-enum class SolveStatus { success, terminated_by_event };
+enum class SolveStatus { success, terminated_by_event, failed };
 
 template <class V>
 struct Solution {
   using real_type = real_t<typename V::value_type>;
   std::vector<real_type> t;
   std::vector<V> q, v;
-  /// The state where the integration ended (t1, or a terminal event).
+  /// The state where the integration ended (t1, a terminal event, or the last saved state of a failed run).
   real_type t_final{};
   V q_final, v_final;
   long force_evals = 0;         // by the method: every stage, rejected steps and starting-step estimates
@@ -828,6 +832,49 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
   sol.rejected = g.rejected();
 }
 
+/// The run of solve_impl with the method's engine, into sol.
+template <class V, class F, class VE>
+void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
+                const std::vector<Event<V>>& events, Solution<V>& sol, int dir,
+                const Checkpoint<real_t<typename V::value_type>>* resume, bool gbs) {
+  using R = real_t<typename V::value_type>;
+  constexpr bool td = SecondOrderProblem<V, F>::time_dependent;
+  if (gbs || def.info.adaptive) {
+    if (!(opt.rtol >= 0) || !std::isfinite(opt.rtol)) throw invalid_input("rtol must be finite and >= 0");
+    if (!(opt.atol >= 0) || !std::isfinite(opt.atol)) throw invalid_input("atol must be finite and >= 0");
+    if (opt.rtol == 0 && opt.atol == 0)
+      throw invalid_input("method '" + def.info.name + "' needs a tolerance (rtol > 0 or atol > 0)");
+    Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
+    if (gbs) {
+      run_gbs<VE>(run, sol, events, resume);
+    } else {
+      AdaptiveOptions ao = opt.adaptive;
+      ao.tol = opt.rtol;
+      ao.atol = opt.atol;
+      ao.max_steps = opt.max_steps;
+      if (std::holds_alternative<MpeDef>(def.build())) {
+        auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);
+        run_adaptive<VE>(run, engine, "adaptive-mpe", def, sol, events, resume);
+      } else {
+        auto engine = make_adaptive_integrator<VE>(def, run.force(), ao);
+        run_adaptive<VE>(run, engine, "adaptive-rkn", def, sol, events, resume);
+      }
+    }
+  } else if (def.info.complex) {
+    using C = std::complex<R>;
+    using VC = rebind_vector_t<V, C>;
+    if constexpr (!td && std::is_invocable_v<F&, const VC&, VC&>) {
+      run_fixed<VC>(prob, def, opt, events, sol, dir, resume);
+    } else {
+      throw invalid_input("method '" + def.info.name +
+                          "' has complex coefficients: its force must accept complex states (a generic lambda or a "
+                          "template operator()) and not depend on time");
+    }
+  } else {
+    run_fixed<VE>(prob, def, opt, events, sol, dir, resume);
+  }
+}
+
 template <class V, class F>
 Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef& def, const SolveOptions& opt,
                        const std::vector<Event<V>>& events, const Checkpoint<real_t<typename V::value_type>>* resume) {
@@ -867,39 +914,19 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
   }
   using VE = typename extended<V, td>::type;
   const bool gbs = def.info.name == "GBS" || def.info.family == "extrapolation";
-  if (gbs || def.info.adaptive) {
-    if (!(opt.rtol >= 0) || !std::isfinite(opt.rtol)) throw invalid_input("rtol must be finite and >= 0");
-    if (!(opt.atol >= 0) || !std::isfinite(opt.atol)) throw invalid_input("atol must be finite and >= 0");
-    if (opt.rtol == 0 && opt.atol == 0)
-      throw invalid_input("method '" + def.info.name + "' needs a tolerance (rtol > 0 or atol > 0)");
-    Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
-    if (gbs) {
-      run_gbs<VE>(run, sol, events, resume);
-    } else {
-      AdaptiveOptions ao = opt.adaptive;
-      ao.tol = opt.rtol;
-      ao.atol = opt.atol;
-      ao.max_steps = opt.max_steps;
-      if (std::holds_alternative<MpeDef>(def.build())) {
-        auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);
-        run_adaptive<VE>(run, engine, "adaptive-mpe", def, sol, events, resume);
-      } else {
-        auto engine = make_adaptive_integrator<VE>(def, run.force(), ao);
-        run_adaptive<VE>(run, engine, "adaptive-rkn", def, sol, events, resume);
-      }
+  try {
+    run_method<V, F, VE>(prob, def, opt, events, sol, dir, resume, gbs);
+  } catch (const invalid_input&) {
+    throw;
+  } catch (const error& e) {
+    if (!opt.partial_on_failure) throw;
+    sol.status = SolveStatus::failed;
+    sol.message = e.what();
+    if (!sol.t.empty()) {
+      sol.t_final = sol.t.back();
+      sol.q_final = sol.q.back();
+      sol.v_final = sol.v.back();
     }
-  } else if (def.info.complex) {
-    using C = std::complex<R>;
-    using VC = rebind_vector_t<V, C>;
-    if constexpr (!td && std::is_invocable_v<F&, const VC&, VC&>) {
-      run_fixed<VC>(prob, def, opt, events, sol, dir, resume);
-    } else {
-      throw invalid_input("method '" + def.info.name +
-                          "' has complex coefficients: its force must accept complex states (a generic lambda or a "
-                          "template operator()) and not depend on time");
-    }
-  } else {
-    run_fixed<VE>(prob, def, opt, events, sol, dir, resume);
   }
   return sol;
 }

@@ -1,0 +1,184 @@
+"""nystrom.quantum: the library's split-operator solver for the Schrödinger and Gross-Pitaevskii equations
+(nystrom/quantum/solve.hpp, the solver of ``nystrom quantum``) from Python.
+
+The propagation runs in C++ with the GIL released; the checks of the input are the library's (ValueError
+with its one-line message), this module converts the arguments and wraps the result.
+"""
+
+import numbers
+
+import numpy as np
+
+from . import _core
+
+__all__ = ["quantum", "QuantumResult"]
+
+
+class QuantumResult(dict):
+    """The result of :func:`nystrom.quantum` (a dict whose keys are also attributes).
+
+    Attributes: ``norm``, ``norm_drift`` (final norm minus initial), ``energy`` (<H>, with g|psi|^2/2 for
+    Gross-Pitaevskii), ``chemical_potential``, ``mean_position``, ``mean_momentum`` (one value per dimension),
+    ``energies`` (imaginary time: the energies of the ``states`` lowest states, ground state first),
+    ``psi`` (the final wave function, complex128 of shape ``(grid,) * dims`` at x_i = -box/2 + i box/grid),
+    ``times`` with ``sample_norms``, ``sample_energies``, ``sample_mean_position`` (the observables at the
+    recorded times) and ``autocorrelation`` (C(t) = <psi(0)|psi(t)> at ``times``, when asked for),
+    ``exact_error`` (L2 distance to the exact solution where one is known, else NaN) and ``exact_solution``
+    (its name), ``time``, ``dt``, ``steps``, ``fft_count``, ``seconds`` (wall time of the propagation),
+    ``method``, ``order``, ``precision``.
+    """
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    __setattr__ = dict.__setitem__
+
+    def __repr__(self):
+        return (f"QuantumResult(method={self.method!r}, energy={self.energy!r}, norm={self.norm!r}, "
+                f"time={self.time!r}, fft_count={self.fft_count!r})")
+
+    def __reduce__(self):
+        return (QuantumResult, (dict(self),))
+
+
+def _integer(name, x):
+    if isinstance(x, bool) or not isinstance(x, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {type(x).__name__}")
+    x = int(x)
+    if not -2**31 <= x < 2**31:
+        raise ValueError(f"{name} is out of range, got {x}")
+    return x
+
+
+def _real(name, x):
+    if isinstance(x, bool) or not isinstance(x, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {type(x).__name__}")
+    return float(x)
+
+
+def _vector(name, x):
+    """x0 or p0: one number (the first axis) or one per axis."""
+    arr = np.asarray(x)
+    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
+        raise TypeError(f"{name} must be a number or a sequence of real numbers")
+    if arr.ndim > 1:
+        raise ValueError(f"{name} must be a number or a sequence of numbers, got shape {arr.shape}")
+    return [float(v) for v in arr.reshape(-1)]
+
+
+def _progress(progress):
+    if progress is None or progress is False:
+        return None
+    if callable(progress):
+        return progress, None
+    if progress is True:
+        from ._progress import make_progress
+
+        bar = None
+
+        def update(done, total):
+            nonlocal bar
+            if bar is None:
+                bar = make_progress(True, 0, total)
+            bar.update(done)
+
+        return update, lambda: bar is not None and bar.close()
+    raise TypeError("progress must be True, False or a callable progress(done, total)")
+
+
+def quantum(potential="harmonic", dims=1, grid=256, box=20.0, method="M8", dt=0.05, steps=200,
+            imaginary_time=False, x0=1.0, p0=0.0, width=1.0, g=0.0, states=1, precision="double",
+            autocorrelation=False, samples=None, potential_values=None, threads=1, progress=False):
+    """Propagate a Gaussian wave packet by i psi_t = (-nabla^2/2 + V + g|psi|^2) psi (units hbar = m = 1) on
+    the periodic grid [-box/2, box/2)^dims with ``grid`` points per axis, by ``steps`` steps of ``dt`` of a
+    splitting or multi-product method (the library's split-operator solver, as ``nystrom quantum``).
+
+    Parameters
+    ----------
+    potential : str
+        ``"harmonic"`` (|x|^2/2), ``"anisotropic"``, ``"morse"``, ``"double-well"``, ``"soft-coulomb"``,
+        ``"free"`` (docs/quantum.md).
+    potential_values : array_like, optional
+        The potential's values on the grid, shape ``(grid,) * dims`` (index i of an axis at
+        x_i = -box/2 + i box/grid); replaces ``potential``.
+    dims, grid, box : int, int, float
+        Dimensions (1 to 3), points per axis, box length.
+    method : str
+        A splitting or multi-product method of the catalog (``"M8"``, ``"Yoshida6"``, ``"Strang"``,
+        ``"mpe4:1,2,3"``, ``"4A"``, ...); RKN tableaux and adaptive methods do not apply.
+    dt, steps : float, int
+        The step (in real or imaginary time) and the number of steps.
+    imaginary_time : bool
+        Propagate in imaginary time, renormalising after every step (relaxes to the ground state).
+    x0, p0, width : float or sequence, float
+        The initial Gaussian: centre and momentum (one number: the first axis; or one per axis), width
+        (1: the harmonic coherent state).
+    g : float
+        Gross-Pitaevskii coupling (with |psi|^2 normalised to 1).
+    states : int
+        Imaginary time, g = 0: the ``states`` lowest states by orthogonalisation (``energies``).
+    precision : str
+        ``"double"`` or ``"long-double"`` (results in float64 and complex128).
+    autocorrelation : bool
+        Record C(t) = <psi(0)|psi(t)> after every step (``times``, ``autocorrelation``).
+    samples : int, optional
+        Record the observables at this many evenly spaced times besides t = 0 (default: none, or every
+        step with ``autocorrelation``).
+    threads : int
+        FFTW threads per transform.
+    progress : bool or callable
+        True: a progress bar (tqdm if installed, else a line on stderr); a callable gets
+        ``progress(steps_done, steps_total)``. Ctrl-C interrupts the run (KeyboardInterrupt) either way.
+
+    Returns
+    -------
+    QuantumResult
+    """
+    if not hasattr(_core, "quantum"):
+        raise RuntimeError("this nystrom module was built without FFTW: the quantum solver is not available")
+    for name, value in (("potential", potential), ("method", method), ("precision", precision)):
+        if not isinstance(value, str):
+            raise TypeError(f"{name} must be a string, got {type(value).__name__}")
+    dims, grid, steps, states = (_integer(n, v) for n, v in (("dims", dims), ("grid", grid), ("steps", steps),
+                                                            ("states", states)))
+    threads = _integer("threads", threads)
+    box, dt, width, g = (_real(n, v) for n, v in (("box", box), ("dt", dt), ("width", width), ("g", g)))
+    x0, p0 = _vector("x0", x0), _vector("p0", p0)
+    if samples is None:
+        samples = steps if autocorrelation else 0
+    samples = _integer("samples", samples)
+    values = None
+    if potential_values is not None:
+        values = np.asarray(potential_values)
+        if not (np.issubdtype(values.dtype, np.floating) or np.issubdtype(values.dtype, np.integer)):
+            raise TypeError(f"potential_values must be an array of real numbers, got dtype {values.dtype}")
+        expected = (grid,) * dims if 1 <= dims <= 3 and grid > 0 else None
+        if expected is not None and values.shape != expected:
+            raise ValueError(f"potential_values has shape {values.shape}, expected {expected} (grid points per axis)")
+        values = np.ascontiguousarray(values, dtype=float).reshape(-1)
+    prog = _progress(progress)
+    try:
+        d = _core.quantum(potential, values, dims, grid, box, method, dt, steps, bool(imaginary_time), x0, p0,
+                          width, g, states, precision, bool(autocorrelation), samples, threads,
+                          None if prog is None else prog[0])
+    finally:
+        if prog is not None and prog[1] is not None:
+            prog[1]()
+
+    res = QuantumResult()
+    for key in ("method", "order", "dt", "time", "steps", "norm", "norm_drift", "energy", "chemical_potential",
+                "mean_position", "mean_momentum", "energies", "exact_error", "exact_solution", "fft_count",
+                "seconds", "psi"):
+        res[key] = d[key]
+    res.time = float(res.time)
+    res.times = d["sample_times"]
+    res.sample_norms = d["sample_norms"]
+    res.sample_energies = d["sample_energies"]
+    res.sample_mean_position = d["sample_mean_position"]
+    res.autocorrelation = d["sample_autocorrelation"] if autocorrelation else None
+    res.final_autocorrelation = complex(d["final_autocorrelation"]) if autocorrelation else None
+    res.precision = precision
+    return res
