@@ -262,8 +262,39 @@ NYSTROM_TARGET_AVX512 inline void avx512_diag_real(const RealTileData& d, std::s
   }
 }
 
-/// Both directions of the interactions between block I (at i0) and block J (at j0), each pair once.
-/// Two rows i, i+1 at a time (B is a multiple of 8): two independent dependency chains per iteration.
+/// r2^{-3/2} of rows i and i+1 with the B partners of block J (at j0), into w (row i) and w + B (row i+1);
+/// lanes with r2 == 0 give 0 when Masked. Iterations independent of each other: only loads, the short
+/// arithmetic of avx512_inv_r3 and stores, which the processor overlaps across iterations.
+template <bool Masked>
+NYSTROM_TARGET_AVX512 inline void avx512_real_w_rows(const RealTileData& d, std::size_t i, std::size_t j0,
+                                                     std::size_t B, __m512d e2, double* __restrict w) {
+  const __m512d xi = _mm512_set1_pd(d.x[i]), yi = _mm512_set1_pd(d.y[i]), zi = _mm512_set1_pd(d.z[i]);
+  const __m512d xk = _mm512_set1_pd(d.x[i + 1]), yk = _mm512_set1_pd(d.y[i + 1]), zk = _mm512_set1_pd(d.z[i + 1]);
+  for (std::size_t j = 0; j < B; j += 8) {
+    const __m512d X = _mm512_loadu_pd(d.x + j0 + j), Y = _mm512_loadu_pd(d.y + j0 + j);
+    const __m512d Z = _mm512_loadu_pd(d.z + j0 + j);
+    const __m512d dx = _mm512_sub_pd(X, xi), dy = _mm512_sub_pd(Y, yi), dz = _mm512_sub_pd(Z, zi);
+    const __m512d ex = _mm512_sub_pd(X, xk), ey = _mm512_sub_pd(Y, yk), ez = _mm512_sub_pd(Z, zk);
+    const __m512d r2 = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, e2)));
+    const __m512d s2 = _mm512_fmadd_pd(ex, ex, _mm512_fmadd_pd(ey, ey, _mm512_fmadd_pd(ez, ez, e2)));
+    __m512d u = avx512_inv_r3(r2), v = avx512_inv_r3(s2);
+    if constexpr (Masked) {
+      u = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(r2, _mm512_setzero_pd(), _CMP_NEQ_OQ), u);
+      v = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(s2, _mm512_setzero_pd(), _CMP_NEQ_OQ), v);
+    }
+    _mm512_store_pd(w + j, u);
+    _mm512_store_pd(w + B + j, v);
+  }
+}
+
+inline constexpr std::size_t real_max_block = 256;  // nbody_block's largest block
+
+/// Both directions of the interactions between block I (at i0) and block J (at j0), each pair once, in two
+/// passes per two rows i, i+1 (B is a multiple of 8), as avx512_pair_complex: first r2^{-3/2} of both rows
+/// with the whole block J (avx512_real_w_rows), then, with the separations recomputed, a_i += m_j w_ij d_ij
+/// and a_j -= m_i w_ij d_ij (then row i+1). The arithmetic and its order are those of one pass per 8
+/// partners; the first pass's iterations are short and independent, so the processor overlaps them, where in
+/// one pass the chain of r2^{-3/2} and the accumulations of each iteration limited the overlap.
 template <bool Masked>
 NYSTROM_TARGET_AVX512 inline void avx512_pair_real(const RealTileData& d, std::size_t i0, std::size_t j0, std::size_t B,
                                                    double eps2) {
@@ -275,23 +306,19 @@ NYSTROM_TARGET_AVX512 inline void avx512_pair_real(const RealTileData& d, std::s
   double* __restrict ax = d.ax;
   double* __restrict ay = d.ay;
   double* __restrict az = d.az;
+  alignas(64) double wbuf[2 * real_max_block];
   for (std::size_t i = i0; i < i0 + B; i += 2) {
+    avx512_real_w_rows<Masked>(d, i, j0, B, e2, wbuf);
     const __m512d xi = _mm512_set1_pd(x[i]), yi = _mm512_set1_pd(y[i]), zi = _mm512_set1_pd(z[i]);
     const __m512d xk = _mm512_set1_pd(x[i + 1]), yk = _mm512_set1_pd(y[i + 1]), zk = _mm512_set1_pd(z[i + 1]);
     const __m512d mi = _mm512_set1_pd(m[i]), mk = _mm512_set1_pd(m[i + 1]);
     __m512d sx = _mm512_setzero_pd(), sy = sx, sz = sx, tx = sx, ty = sx, tz = sx;
-    for (std::size_t j = j0; j < j0 + B; j += 8) {
+    for (std::size_t j = j0, jw = 0; j < j0 + B; j += 8, jw += 8) {
       const __m512d X = _mm512_loadu_pd(x + j), Y = _mm512_loadu_pd(y + j), Z = _mm512_loadu_pd(z + j);
       const __m512d M = _mm512_loadu_pd(m + j);
       const __m512d dx = _mm512_sub_pd(X, xi), dy = _mm512_sub_pd(Y, yi), dz = _mm512_sub_pd(Z, zi);
       const __m512d ex = _mm512_sub_pd(X, xk), ey = _mm512_sub_pd(Y, yk), ez = _mm512_sub_pd(Z, zk);
-      const __m512d r2 = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, e2)));
-      const __m512d s2 = _mm512_fmadd_pd(ex, ex, _mm512_fmadd_pd(ey, ey, _mm512_fmadd_pd(ez, ez, e2)));
-      __m512d w = avx512_inv_r3(r2), v = avx512_inv_r3(s2);
-      if constexpr (Masked) {
-        w = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(r2, _mm512_setzero_pd(), _CMP_NEQ_OQ), w);
-        v = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(s2, _mm512_setzero_pd(), _CMP_NEQ_OQ), v);
-      }
+      const __m512d w = _mm512_load_pd(wbuf + jw), v = _mm512_load_pd(wbuf + B + jw);
       const __m512d wj = _mm512_mul_pd(w, M), vj = _mm512_mul_pd(v, M);
       const __m512d wi = _mm512_mul_pd(w, mi), vk = _mm512_mul_pd(v, mk);
       sx = _mm512_fmadd_pd(wj, dx, sx);
