@@ -153,7 +153,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const auto& r : runs) {
-      if (r.error_occurred || r.iterations <= 0) continue;
+      // Repetitions: each one is a row, the aggregates (mean, stddev, ...) are not; the baseline is the
+      // fastest repetition.
+      if (r.run_type != Run::RT_Iteration || r.error_occurred || r.iterations <= 0) continue;
       const auto p = r.counters.find("pairs"), t = r.counters.find("threads");
       if (p == r.counters.end() || t == r.counters.end()) continue;
       const std::string name = r.benchmark_name();
@@ -162,7 +164,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const double cpu_ns = r.cpu_accumulated_time / it / pairs * 1e9;
       const double wall_ns = r.real_accumulated_time / it / pairs * 1e9 * t->second.value;
       rows_.push_back({name, n, cpu_ns, wall_ns});
-      if (name.rfind("BM_scalar_baseline", 0) == 0) base_[n] = cpu_ns;
+      if (name.rfind("BM_scalar_baseline", 0) == 0 && (!base_.count(n) || cpu_ns < base_[n])) base_[n] = cpu_ns;
     }
   }
   void Finalize() override {
