@@ -6,8 +6,11 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <utility>
+#include <variant>
+#include <vector>
 
 #include "nystrom/analysis/rkn_order_conditions.hpp"
 #include "nystrom/core/extended.hpp"
@@ -144,4 +147,92 @@ TEST(DormandPrince1987, FixedStepConvergenceRates) {
     EXPECT_NEAR(p1, p2, 0.35) << name << " not in the asymptotic range: " << e32 << ", " << e64 << ", " << e128;
     EXPECT_GT(e128, 1e-30) << name << ": at the float128 round-off floor";
   }
+}
+
+namespace {
+
+/// KeplerForce's arithmetic for any state vector of two components.
+struct PlanarKepler {
+  template <class V>
+  void operator()(const V& q, V& a) const {
+    const auto m = -inv_r3(q[0] * q[0] + q[1] * q[1]);
+    a[0] = m * q[0];
+    a[1] = m * q[1];
+  }
+};
+
+/// One step of the pair written out from form (2.1) of the Gürkan paper, each stage position summed when the
+/// stage starts: q_{n+1}, v_{n+1} and the error estimate (differences of the 12th- and 10th-order q and v).
+template <class T, class V>
+State<V> textbook_step(const RknTableau<T>& t, const State<V>& s, T h, State<V>& err) {
+  const std::size_t st = t.stages();
+  std::vector<V> f(st, s.q);
+  for (std::size_t i = 0; i < st; ++i) {
+    V y = s.q;
+    for (std::size_t k = 0; k < y.size(); ++k) {
+      y[k] = s.q[k] + t.c[i] * h * s.v[k];
+      for (std::size_t j = 0; j < i; ++j) y[k] += t.a[i][j] * (h * h) * f[j][k];
+    }
+    PlanarKepler{}(y, f[i]);
+  }
+  State<V> r = s;
+  err = s;
+  for (std::size_t k = 0; k < s.q.size(); ++k) {
+    r.q[k] = s.q[k] + h * s.v[k];
+    err.q[k] = err.v[k] = T(0);
+    for (std::size_t i = 0; i < st; ++i) {
+      r.q[k] += t.b[i] * (h * h) * f[i][k];
+      r.v[k] += t.B[i] * h * f[i][k];
+      err.q[k] += (t.b[i] - t.bhat[i]) * (h * h) * f[i][k];
+      err.v[k] += (t.B[i] - t.Bhat[i]) * h * f[i][k];
+    }
+  }
+  return r;
+}
+
+/// Three steps with error estimates of the RKN engine against textbook_step, each from the engine's state:
+/// the engine sums forward (rkn.hpp), in the same order, so both agree to a few roundings.
+template <class T, class V>
+void check_engine_step(double ecc) {
+  const MethodData data =
+      method_data_for(resolve_method("DP12-adaptive"), scalar_traits<T>::bits(), scalar_traits<T>::name());
+  const auto& tc = std::get<RknTableau<bigcomplex>>(data);
+  const auto t = convert_tableau<T>(tc, [](const bigcomplex& x) { return to_scalar<T>(x); });
+  RknStepper<V, PlanarKepler> stepper(t, PlanarKepler{});
+  const auto k0 = KeplerProblem<T>(T(ecc)).initial_state();
+  State<V> s;
+  if constexpr (!is_std_array<V>::value) {
+    s.q.resize(2);
+    s.v.resize(2);
+  }
+  for (std::size_t k = 0; k < 2; ++k) {
+    s.q[k] = k0.q[k];
+    s.v[k] = k0.v[k];
+  }
+  const T h = T(0.3), eps = std::numeric_limits<T>::epsilon();
+  for (int n = 0; n < 3; ++n) {
+    State<V> e_ref, e;
+    const State<V> ref = textbook_step(t, s, h, e_ref);
+    stepper.step_with_error(s, h, e);
+    for (std::size_t k = 0; k < 2; ++k) {
+      EXPECT_NEAR(static_cast<double>(s.q[k]), static_cast<double>(ref.q[k]), static_cast<double>(8 * eps));
+      EXPECT_NEAR(static_cast<double>(s.v[k]), static_cast<double>(ref.v[k]), static_cast<double>(8 * eps));
+      // The estimate is ~1e-9 here: agreement far below it (the summation order of the estimate matters little).
+      EXPECT_NEAR(static_cast<double>(e.q[k]), static_cast<double>(e_ref.q[k]), static_cast<double>(8 * eps));
+      EXPECT_NEAR(static_cast<double>(e.v[k]), static_cast<double>(e_ref.v[k]), static_cast<double>(8 * eps));
+      EXPECT_GT(std::abs(static_cast<double>(e_ref.q[k])) + std::abs(static_cast<double>(e_ref.v[k])), 0.0);
+    }
+    s = ref;
+  }
+  EXPECT_EQ(stepper.force_evals(), 3 * 17);
+}
+
+}  // namespace
+
+// The engine's forward summation (each force added to the later stages as soon as it is known) against the
+// stages written out, in double and long double, for a fixed-size state and a heap vector.
+TEST(DormandPrince1987, EngineStepMatchesStagesWrittenOut) {
+  check_engine_step<double, std::array<double, 2>>(0.5);
+  check_engine_step<double, std::vector<double>>(0.9);
+  check_engine_step<long double, std::array<long double, 2>>(0.9);
 }
