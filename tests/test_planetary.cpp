@@ -318,7 +318,7 @@ TEST(WisdomHolman, OrderOfTheEnergyErrorInTheStepAndThePerturbation) {
                                          {"WH-M4", 1e-3, 64, 4},
                                          {"WH-FR", 1e-3, 64, 4},
                                          {"WH-M6", 1e-3, 128, 6},
-                                         {"WH-M8", 1e-5, 64, 8},
+                                         {"WH-M8", 1e-4, 40, 8},  // at 2n steps the error stays 1e3 above the rounding
                                          {"WH-mpe:1,2,3,4,6", 1e-5, 16, 10}})
     EXPECT_NEAR(energy_order(c.eps, c.method, c.n), c.order, 0.35) << c.method << " eps = " << c.eps;
 }
