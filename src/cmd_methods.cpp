@@ -10,6 +10,7 @@
 
 #include "cli.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/planetary/wisdom_holman.hpp"
 
 namespace {
 
@@ -46,6 +47,31 @@ std::string join(const std::vector<std::string>& items, const std::string& sep) 
   return out;
 }
 
+/// The Wisdom-Holman maps of `nystrom run --problem outer-solar-system` that have names of their own (any
+/// catalog method also runs over the maps' flows as WH-NAME or WHD-NAME).
+std::vector<nystrom::MethodInfo> planetary_maps() {
+  std::vector<nystrom::MethodInfo> out;
+  std::vector<std::string> names{"WH"};
+  for (int n : nystrom::methods::wh_corrector_orders()) names.push_back("WHC" + std::to_string(n));
+  for (int n = 1; n <= 4; ++n) names.push_back("SABA" + std::to_string(n));
+  for (int n = 1; n <= 4; ++n) names.push_back("SBAB" + std::to_string(n));
+  names.push_back("WHD");
+  for (const auto& n : names) out.push_back(nystrom::planetary::resolve_wh_method(n, 53, "double").info);
+  return out;
+}
+
+std::string markdown_row(const nystrom::MethodInfo& m) {
+  std::vector<std::string> flags;
+  if (m.fsal) flags.push_back("fsal");
+  if (m.symmetric) flags.push_back("sym");
+  if (m.symplectic) flags.push_back("sympl");
+  if (m.complex) flags.push_back("cplx");
+  if (m.adaptive) flags.push_back("adapt");
+  const std::string coefs = m.published_digits == 0 ? "exact" : fmt::format("{} digits", m.published_digits);
+  return fmt::format("| `{}` | {} | {} | {} | {} | {} | {} | {} | {} |\n", m.name, cell(join(m.aliases, ", ")),
+                     m.family, m.order, m.stages, m.forces_per_step, join(flags, " "), coefs, cell(m.source));
+}
+
 std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
   std::string page =
       "# Method catalog\n\n"
@@ -60,18 +86,7 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
       "step), `adapt` adaptive step size from an embedded error estimate (run with a tolerance).\n\n"
       "| name | aliases | family | order | stages | forces | flags | coefficients | source |\n"
       "| --- | --- | --- | ---: | ---: | ---: | --- | --- | --- |\n";
-  for (const auto& d : cat) {
-    const auto& m = d.info;
-    std::vector<std::string> flags;
-    if (m.fsal) flags.push_back("fsal");
-    if (m.symmetric) flags.push_back("sym");
-    if (m.symplectic) flags.push_back("sympl");
-    if (m.complex) flags.push_back("cplx");
-    if (m.adaptive) flags.push_back("adapt");
-    const std::string coefs = m.published_digits == 0 ? "exact" : fmt::format("{} digits", m.published_digits);
-    page += fmt::format("| `{}` | {} | {} | {} | {} | {} | {} | {} | {} |\n", m.name, cell(join(m.aliases, ", ")),
-                        m.family, m.order, m.stages, m.forces_per_step, join(flags, " "), coefs, cell(m.source));
-  }
+  for (const auto& d : cat) page += markdown_row(d.info);
   page +=
       "\n## Method specifications beyond the table\n\n"
       "Every command that takes a method also accepts:\n\n"
@@ -86,6 +101,15 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
       "  by hand (format: include/nystrom/analysis/method_file.hpp); its declared order is verified on loading.\n\n"
       "The command-line tool also runs `GBS`, Gragg-Bulirsch-Stoer extrapolation with Hairer's order and step\n"
       "control, given a tolerance (`nystrom run --method GBS --tol 1e-12`); it serves as the reference solution.\n";
+  page +=
+      "\n## Planetary maps\n\n"
+      "`nystrom run --problem outer-solar-system` also runs the Wisdom-Holman maps (docs/planetary.md): a stage is\n"
+      "one interaction kick, the order is the order in the step (the error of a map with small perturbation eps is\n"
+      "given in its description: `nystrom methods` lists them), and `WH-NAME` / `WHD-NAME` run any real splitting or\n"
+      "multi-product method NAME of the catalog over the Jacobi / democratic heliocentric flows (`WH-M8`).\n\n"
+      "| name | aliases | family | order | stages | forces | flags | coefficients | source |\n"
+      "| --- | --- | --- | ---: | ---: | ---: | --- | --- | --- |\n";
+  for (const auto& m : planetary_maps()) page += markdown_row(m);
   return page;
 }
 
@@ -115,6 +139,10 @@ nystrom::cli::Registrar reg("methods", "List every method in the catalog", [](CL
                  m.forces_per_step, yn(m.fsal), yn(m.symmetric), yn(m.symplectic), yn(m.complex), m.source);
     }
     fmt::print("\nAlso: M<2n> (any even order), mpe:K1,K2,... (PV base), mpe-vv:K1,K2,..., adjoint:NAME.\n");
+    fmt::print("\nPlanetary maps (run --problem outer-solar-system; also WH-NAME, WHD-NAME for catalog methods):\n");
+    for (const auto& m : planetary_maps())
+      fmt::print("{:<12} {:<12} {:>5} {:>6} {:>6}  {}\n", m.name, m.family, m.order, m.stages, m.forces_per_step,
+                 m.description);
     return 0;
   };
 });

@@ -149,7 +149,8 @@ Outcome run_direct(const MethodDef& def, double h, long steps, double tol) {
 }
 
 bool is_map(const std::string& method) {
-  return method == "WH" || method.rfind("WH-", 0) == 0 || method.rfind("SABA", 0) == 0 || method.rfind("SBAB", 0) == 0;
+  return method == "WH" || method.rfind("WH-", 0) == 0 || method.rfind("WHC", 0) == 0 || method.rfind("WHD", 0) == 0 ||
+         method.rfind("SABA", 0) == 0 || method.rfind("SBAB", 0) == 0;
 }
 
 }  // namespace

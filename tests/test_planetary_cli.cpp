@@ -61,11 +61,30 @@ TEST(PlanetaryCli, DirectMethodsRunOnTheCartesianEquations) {
   EXPECT_TRUE(j["reference"].is_null());
 }
 
+// The corrected map and the democratic heliocentric maps run from the command line; the corrector costs kicks
+// only at the outputs (about a thousand energy samples), and lowers the map's energy error.
+TEST(PlanetaryCli, CorrectorAndDemocraticHeliocentricMaps) {
+  const auto wh = run_json("--method WH --h 100 --years 1000 --no-reference");
+  const auto c7 = run_json("--method WHC7 --h 100 --years 1000 --no-reference");
+  const auto d8 = run_json("--method WHD-M8 --h 100 --years 1000 --no-reference");
+  ASSERT_FALSE(wh.empty());
+  ASSERT_FALSE(c7.empty());
+  ASSERT_FALSE(d8.empty());
+  EXPECT_EQ(c7["method"], "WHC7");
+  EXPECT_LT(c7["energy_error_max"].get<double>(), wh["energy_error_max"].get<double>() / 2);
+  EXPECT_EQ(d8["method"], "WHD-M8");
+  EXPECT_EQ(d8["order"], 8);
+  EXPECT_LT(d8["energy_error_max"].get<double>(), wh["energy_error_max"].get<double>() * 1e-3);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(d8["jupiter_position"][k].get<double>(), c7["jupiter_position"][k].get<double>(), 1e-3);
+}
+
 TEST(PlanetaryCli, BadInputIsOneLineAndExitTwo) {
-  for (const char* args : {"--method WH-BC1 --h 200 --years 10", "--method nonsense --h 200 --years 10",
-                           "--method WH --h 0 --years 10", "--method WH --h 200 --years -1",
-                           "--method WH --h 1e9 --years 1", "--method WH --h 200 --years 10 --precision qd",
-                           "--method DP12-adaptive --h 200 --years 10", "--h 200 --years 10"}) {
+  for (const char* args :
+       {"--method WH-BC1 --h 200 --years 10", "--method nonsense --h 200 --years 10", "--method WH --h 0 --years 10",
+        "--method WH --h 200 --years -1", "--method WH --h 1e9 --years 1",
+        "--method WH --h 200 --years 10 --precision qd", "--method DP12-adaptive --h 200 --years 10",
+        "--h 200 --years 10", "--method WHC9 --h 200 --years 10", "--method WHD-VV --h 200 --years 10"}) {
     const auto r = run(std::string("run --problem outer-solar-system ") + args + " --no-reference");
     EXPECT_EQ(r.code, 2) << args;
     EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;

@@ -196,18 +196,17 @@ class MpeFlowStepper {
   const std::vector<long>& sequence() const { return k_; }
   const std::vector<real_type>& coefficients() const { return c_; }
 
+  // s + sum_i c_i (T_i - s), not sum_i c_i T_i: the rounded c_i sum to 1 only to rounding, and the plain sum
+  // scales the state by that sum every step, a secular error (measured on the outer solar system with WH-M8:
+  // relative energy error growing with the number of steps, 1e-10 over 1e5 years); in the increments the
+  // coefficients' rounding multiplies T_i - s only.
   void step(F& f, state_type& s, real_type h) {
-    bool first = true;
+    f.assign(sum_, s);
     for (std::size_t i : order_) {
       f.assign(work_, s);
       products_[i].apply_once(f, work_, h);
-      if (first) {
-        f.assign(sum_, work_);
-        f.scale(sum_, c_[i]);
-        first = false;
-      } else {
-        f.axpy(sum_, c_[i], work_);
-      }
+      f.axpy(work_, real_type(-1), s);
+      f.axpy(sum_, c_[i], work_);
     }
     using std::swap;
     swap(s, sum_);

@@ -20,17 +20,21 @@
 //   WH-<catalog name> any real splitting or multi-product method of the catalog over these flows, e.g. WH-M8 =
 //                     Chin's multi-product expansion of order 8 over the WH map (the natural sequence 1..4),
 //                     WH-KL8 = Kahan-Li's composition of WH maps, WH-mpe:1,2,3,4,5 (any sequence);
-//   SABA1..4, SBAB1..4 Laskar & Robutel's maps (methods/laskar_robutel2001.hpp).
+//   SABA1..4, SBAB1..4 Laskar & Robutel's maps (methods/laskar_robutel2001.hpp);
+//   WHC3, WHC5, WHC7, WHC11, WHC17  the map with the symplectic corrector of that order (Wisdom, Holman &
+//                     Touma 1996; methods/wisdom_holman_touma1996.hpp): C before the first step, C^{-1} applied
+//                     to a copy at every output, error O(eps h^{n+1} + eps^2 h^2).
 // Complex coefficients are refused: a Kepler drift over a complex time has no meaning for the orbits.
 //
-// Heliocentric "democratic" coordinates (Duncan, Levison & Lee, AJ 116 (1998) 2067) need a third flow (the
-// Sun's momentum drift) and are not offered; the Jacobi splitting is the one of Wisdom & Holman and WHFast.
+//   WHD, WHD-<name>   the map in democratic heliocentric coordinates (planetary/democratic.hpp) and any
+//                     splitting or multi-product method of the catalog over it whose kicks never meet (WHD-M8).
 #pragma once
 
 #include <algorithm>
 #include <complex>
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -38,7 +42,9 @@
 
 #include "nystrom/core/scalar.hpp"
 #include "nystrom/methods/laskar_robutel2001.hpp"
+#include "nystrom/methods/wisdom_holman_touma1996.hpp"
 #include "nystrom/operators/flow_methods.hpp"
+#include "nystrom/planetary/democratic.hpp"
 #include "nystrom/planetary/kepler_drift.hpp"
 #include "nystrom/planetary/system.hpp"
 
@@ -124,22 +130,68 @@ class JacobiFlows {
   long drifts_ = 0, kicks_ = 0;
 };
 
+/// The order of the symplectic corrector a method name asks for (WHC3 -> 3), 0 for a method without one.
+/// Throws std::invalid_argument for WHC<n> with no published corrector of order n.
+inline int wh_corrector_order(const std::string& spec) {
+  if (spec.rfind("WHC", 0) != 0 || spec.size() < 4 || spec.size() > 5) return 0;
+  for (int n : methods::wh_corrector_orders())
+    if (spec == "WHC" + std::to_string(n)) return n;
+  throw std::invalid_argument("unknown planetary method '" + spec + "': the symplectic correctors are WHC3, WHC5, " +
+                              "WHC7, WHC11 and WHC17");
+}
+
+/// Whether a method name asks for democratic heliocentric coordinates (WHD, WHD-<catalog method>).
+inline bool is_democratic(const std::string& spec) { return spec == "WHD" || spec.rfind("WHD-", 0) == 0; }
+
 /// Resolves a Wisdom-Holman method name (see the top of this file) with coefficients for a working type of
 /// `bits` bits. Throws std::invalid_argument for unknown names and for methods that do not apply.
 inline operators::FlowMethod resolve_wh_method(const std::string& spec, long bits, const std::string& type_name) {
-  if (spec == "WH")
-    return {MethodInfo{.name = "WH",
-                       .family = "splitting",
-                       .order = 2,
-                       .symmetric = true,
-                       .symplectic = true,
-                       .source = "Wisdom & Holman, AJ 102 (1991) 1528",
-                       .description = "Wisdom-Holman map: Kepler drift h/2, interaction kick h, Kepler drift h/2",
-                       .aliases = {}},
-            position_verlet_scheme()};
+  const MethodInfo wh{.name = "WH",
+                      .family = "splitting",
+                      .order = 2,
+                      .stages = 1,
+                      .forces_per_step = 1,
+                      .symmetric = true,
+                      .symplectic = true,
+                      .source = "Wisdom & Holman, AJ 102 (1991) 1528",
+                      .description = "Wisdom-Holman map: Kepler drift h/2, interaction kick h, Kepler drift h/2",
+                      .aliases = {}};
+  if (spec == "WH") return {wh, position_verlet_scheme()};
+  if (const int n = wh_corrector_order(spec); n > 0) {
+    MethodInfo info = wh;
+    info.name = spec;
+    info.source = "Wisdom, Holman & Touma, Fields Inst. Commun. 10 (1996) 217; Rein & Tamayo, MNRAS 452 (2015) 376";
+    info.description = "Wisdom-Holman map with the symplectic corrector of order " + std::to_string(n) +
+                       ": error O(eps h^" + std::to_string(n + 1) + " + eps^2 h^2) for H = A + eps B";
+    return {info, position_verlet_scheme()};
+  }
   for (const MethodDef& def : methods::laskar_robutel2001())
-    if (def.info.name == spec)
-      return {def.info, std::get<SplittingScheme<bigcomplex>>(method_data_for(def, bits, type_name))};
+    if (def.info.name == spec) {
+      auto sc = std::get<SplittingScheme<bigcomplex>>(method_data_for(def, bits, type_name));
+      MethodInfo info = def.info;
+      info.forces_per_step = info.stages = normalized(sc).forces_per_step();
+      info.fsal = normalized(sc).fsal();
+      return {info, std::move(sc)};
+    }
+  if (is_democratic(spec)) {
+    operators::FlowMethod m =
+        spec == "WHD"
+            ? operators::FlowMethod{wh, position_verlet_scheme()}
+            : operators::resolve_flow_method(spec.substr(4), operators::OperatorStructure::general, bits, type_name);
+    const SplittingScheme<bigcomplex>* sc = std::get_if<SplittingScheme<bigcomplex>>(&m.data);
+    if (const auto* mpe = std::get_if<operators::FlowMpeDef>(&m.data)) sc = &mpe->base;
+    if (m.info.complex || !sc || sc->steps.empty() || sc->steps.front().flow != Flow::drift ||
+        sc->steps.back().flow != Flow::drift)
+      throw std::invalid_argument("'" + spec + "': democratic heliocentric coordinates take real splittings and " +
+                                  "multi-product expansions that begin and end with a Kepler drift (over the " +
+                                  "position-Verlet base)");
+    m.info.name = spec;
+    m.info.source = m.info.source + "; Duncan, Levison & Lee, AJ 116 (1998) 2067";
+    m.info.description = spec == "WHD" ? "Wisdom-Holman map in democratic heliocentric coordinates: Kepler drift "
+                                         "h/2, jump h/2, interaction kick h, jump h/2, Kepler drift h/2"
+                                       : m.info.description + ", over the democratic heliocentric map";
+    return m;
+  }
   if (spec.rfind("WH-", 0) == 0 && spec.size() > 3) {
     operators::FlowMethod m =
         operators::resolve_flow_method(spec.substr(3), operators::OperatorStructure::rkn, bits, type_name);
@@ -150,8 +202,10 @@ inline operators::FlowMethod resolve_wh_method(const std::string& spec, long bit
     m.info.name = spec;
     return m;
   }
-  throw std::invalid_argument("unknown planetary method '" + spec +
-                              "': use WH, WH-<catalog method> (e.g. WH-M8), SABA1..SABA4 or SBAB1..SBAB4");
+  throw std::invalid_argument(
+      "unknown planetary method '" + spec +
+      "': use WH, WH-<catalog method> (e.g. WH-M8), WHC3..WHC17, SABA1..SABA4, SBAB1..SBAB4, WHD or " +
+      "WHD-<catalog method>");
 }
 
 /// What a run observes: called before the first step and after every `every` steps (and after the last).
@@ -168,7 +222,63 @@ struct PropagateResult {
   long kepler_drifts = 0, kicks = 0;
 };
 
-/// Advances a planetary system by `steps` steps of size h with a Wisdom-Holman method.
+namespace detail {
+
+/// Runs `fm` over flows F from the flat state s (C^{-1} of the outputs when a corrector is given); `jacobi`
+/// maps a state of F to the Jacobi state the observer receives, `inertial` to inertial positions and velocities.
+template <class F, class R, class ToJacobi, class ToInertial>
+PropagateResult<R> run_flows(const PlanetarySystem<R>& sys, const operators::FlowMethod& fm, int corrector_order,
+                             std::vector<R> s, R h, long steps, const PropagateOptions<R>& opt, ToJacobi jacobi,
+                             ToInertial inertial) {
+  F flows(sys.G, sys.mass);
+  operators::FlowIntegrator<F> integ(fm);
+  // a symplectic corrector: C before the first step; the outputs are C^{-1} of the state, on a copy
+  using Stepper = operators::SplittingFlowStepper<F>;
+  std::optional<Stepper> corrector, inverse;
+  if (corrector_order > 0) {
+    SplittingScheme<std::complex<R>> c;
+    {
+      const BigPrecision guard(reference_bits(scalar_traits<R>::bits()));
+      c = convert_scheme<std::complex<R>>(methods::wh_corrector_scheme(corrector_order),
+                                          [](const bigcomplex& x) { return to_scalar<std::complex<R>>(x); });
+    }
+    SplittingScheme<std::complex<R>> ci = adjoint(c);
+    for (auto& st : ci.steps) st.coef = -st.coef;
+    corrector.emplace(c);
+    inverse.emplace(ci);
+    corrector->apply_once(flows, s, h);
+  }
+  std::vector<R> out;
+  auto output = [&]() -> const std::vector<R>& {
+    if (!inverse) return s;
+    out = s;
+    inverse->apply_once(flows, out, h);
+    return out;
+  };
+  if (opt.every > 0 && opt.observer) {
+    opt.observer(0, jacobi(output()));
+    for (long done = 0; done < steps;) {
+      const long chunk = std::min(opt.every, steps - done);
+      integ.integrate(flows, s, h, chunk);
+      done += chunk;
+      opt.observer(done, jacobi(output()));
+    }
+  } else {
+    integ.integrate(flows, s, h, steps);
+  }
+  PropagateResult<R> r;
+  r.system = sys;
+  inertial(output(), r.system.x, r.system.v);
+  r.method = fm.info;
+  r.kepler_drifts = flows.kepler_drifts();
+  r.kicks = flows.kicks();
+  return r;
+}
+
+}  // namespace detail
+
+/// Advances a planetary system by `steps` steps of size h with a Wisdom-Holman method (in Jacobi coordinates, or
+/// in democratic heliocentric ones for the WHD methods). The observer receives the Jacobi state either way.
 template <class R>
 PropagateResult<R> propagate(const PlanetarySystem<R>& sys, const std::string& method, R h, long steps,
                              const PropagateOptions<R>& opt = {}) {
@@ -177,27 +287,26 @@ PropagateResult<R> propagate(const PlanetarySystem<R>& sys, const std::string& m
     throw std::invalid_argument("the step must be positive and finite");
   if (steps < 0) throw std::invalid_argument("the number of steps must not be negative");
   const operators::FlowMethod fm = resolve_wh_method(method, scalar_traits<R>::bits(), scalar_traits<R>::name());
-  JacobiFlows<R> flows(sys.G, sys.mass);
-  operators::FlowIntegrator<JacobiFlows<R>> integ(fm);
-  std::vector<R> s = to_jacobi(sys);
-  if (opt.every > 0 && opt.observer) {
-    opt.observer(0, s);
-    for (long done = 0; done < steps;) {
-      const long chunk = std::min(opt.every, steps - done);
-      integ.integrate(flows, s, h, chunk);
-      done += chunk;
-      opt.observer(done, s);
-    }
-  } else {
-    integ.integrate(flows, s, h, steps);
+  if (is_democratic(method)) {
+    PlanetarySystem<R> tmp = sys;
+    auto inertial = [&](const std::vector<R>& st, std::vector<Vec3<R>>& x, std::vector<Vec3<R>>& v) {
+      from_democratic(sys.mass, st, x, v);
+    };
+    std::vector<R> j;
+    auto jacobi = [&](const std::vector<R>& st) -> const std::vector<R>& {
+      from_democratic(sys.mass, st, tmp.x, tmp.v);
+      j = to_jacobi(tmp);
+      return j;
+    };
+    return detail::run_flows<DemocraticHeliocentricFlows<R>>(sys, fm, 0, to_democratic(sys), h, steps, opt, jacobi,
+                                                             inertial);
   }
-  PropagateResult<R> r;
-  r.system = sys;
-  from_jacobi(sys.mass, s, r.system.x, r.system.v);
-  r.method = fm.info;
-  r.kepler_drifts = flows.kepler_drifts();
-  r.kicks = flows.kicks();
-  return r;
+  auto inertial = [&](const std::vector<R>& st, std::vector<Vec3<R>>& x, std::vector<Vec3<R>>& v) {
+    from_jacobi(sys.mass, st, x, v);
+  };
+  auto jacobi = [](const std::vector<R>& st) -> const std::vector<R>& { return st; };
+  return detail::run_flows<JacobiFlows<R>>(sys, fm, wh_corrector_order(method), to_jacobi(sys), h, steps, opt, jacobi,
+                                           inertial);
 }
 
 }  // namespace nystrom::planetary
