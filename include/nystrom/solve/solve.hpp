@@ -884,7 +884,7 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
         auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);
         run_adaptive<VE>(run, engine, "adaptive-mpe", def, sol, events, resume);
       } else {
-        auto engine = make_adaptive_integrator<VE>(def, run.force(), ao);
+        auto engine = make_adaptive_integrator<VE>(def, run.force(), ao, opt.engine);
         run_adaptive<VE>(run, engine, "adaptive-rkn", def, sol, events, resume);
       }
     }
