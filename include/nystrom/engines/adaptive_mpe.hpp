@@ -137,6 +137,15 @@ class AdaptiveMpeIntegrator {
     if (eopt_.mpe_schedule == MpeSchedule::concurrent)
       throw std::invalid_argument(
           "adaptive MPE: the concurrent schedule is not available (use lockstep or sequential)");
+    // The round-off of the error estimate sum d_i (D_i - D_ref) is at most about eps sum |d_i| times the
+    // increment; the controller aims at err = safety^(p+1) (0.2 for M16), so a floor 10 times that level keeps
+    // the estimate's noise below the aim: at tolerances near eps the step then stops shrinking where the
+    // estimate reaches its round-off. Kepler e = 0.5, 100 periods, M16-adaptive at tol 3.2e-15: 5742 steps and
+    // a final position error of 6e-11 without the floor, 2031 steps and 9e-11 with it (e = 0.9: 9314 and 1.3e-10,
+    // 4512 and 5e-11).
+    double dsum = 0;
+    for (const auto& di : d_) dsum += std::abs(as_double(di));
+    noise_floor_ = real_type(10 * dsum * as_double(epsilon_of<real_type>()));
     method_order_ = 2 * static_cast<int>(k_.size());
     if (opt_.error_order == 0) opt_.error_order = method_order_ - 2;
     ref_ = static_cast<std::size_t>(std::max_element(k_.begin(), k_.end()) - k_.begin());
@@ -511,16 +520,18 @@ class AdaptiveMpeIntegrator {
     return evals;
   }
 
-  /// The mixed norm of the error estimate, squared, in double (NaN or inf: +inf, i.e. reject).
+  /// The mixed norm of the error estimate, squared, in double (NaN or inf: +inf, i.e. reject). The scale
+  /// of a component is at least noise |increment| (noise_floor_): an estimate at its own round-off level
+  /// is not an error the step size can reduce.
   static double error_norm2(const State<V>& y0, const State<V>& inc, const State<V>& e,
-                            const adaptive_detail::ErrorScale<real_type>& sc) {
+                            const adaptive_detail::ErrorScale<real_type>& sc, const real_type& noise) {
     using std::abs;
     double sum = 0;
     const std::size_t n = y0.q.size();
     for (std::size_t i = 0; i < n; ++i) {
       const real_type q1 = y0.q[i] + inc.q[i], v1 = y0.v[i] + inc.v[i];
-      const real_type sq = sc(std::max(abs(y0.q[i]), abs(q1)));
-      const real_type sv = sc(std::max(abs(y0.v[i]), abs(v1)));
+      const real_type sq = std::max(sc(std::max(abs(y0.q[i]), abs(q1))), real_type(noise * abs(inc.q[i])));
+      const real_type sv = std::max(sc(std::max(abs(y0.v[i]), abs(v1))), real_type(noise * abs(inc.v[i])));
       const double rq = as_double(real_type(e.q[i] / sq)), rv = as_double(real_type(e.v[i] / sv));
       sum += rq * rq + rv * rv;
     }
@@ -614,7 +625,7 @@ class AdaptiveMpeIntegrator {
           trial<Comp>(std::integral_constant<std::size_t, K>{}, s, a0, lx, la, lcq, lcv, inc, err);
       } else
         trial<Comp>(k_.size(), s, a0, xs_, as_, cqs_, cvs_, inc, err);
-      const double e2 = error_norm2(s, inc, err, err_scale);
+      const double e2 = error_norm2(s, inc, err, err_scale, noise_floor_);
       error_finite = e2 < std::numeric_limits<double>::infinity();
       if (e2 <= 1.0) {
         for (std::size_t j = 0; j < s.q.size(); ++j) {
@@ -655,9 +666,10 @@ class AdaptiveMpeIntegrator {
   std::size_t ref_ = 0, m_ = 0;
   bool kick_first_ = false, lockstep_ = false, compensated_ = false;
   int method_order_ = 0;
-  long extra_evals_ = 0;  // forces outside the base's count: starting steps, forces at q_0
-  long own_evals_ = 0;    // forces of the products in increment form
-  bool merged_ = false;   // the base's steps merge (every symmetric base): the increment form applies
+  real_type noise_floor_{};  // the error scale's floor, relative to the increment (see the constructor)
+  long extra_evals_ = 0;     // forces outside the base's count: starting steps, forces at q_0
+  long own_evals_ = 0;       // forces of the products in increment form
+  bool merged_ = false;      // the base's steps merge (every symmetric base): the increment form applies
   V qbuf_{};
   real_type h_next_ = real_type(0);
   AdaptiveResumePoint<real_type> resume_;

@@ -34,7 +34,14 @@
 //     attempt;
 //   * first step: Hairer's starting-step algorithm (two force evaluations) unless opt.h0 > 0; later
 //     calls continue with the step proposed at the end of the previous call;
-//   * the last step is shortened to land exactly on t1 (and a step within 1% of the end is stretched).
+//   * the last step is shortened to land exactly on t1 (and a step within 1% of the end is stretched); every
+//     other step is rounded so that t + h is exact, and the accepted increments are added with compensated
+//     summation (EngineOptions::compensated, on by default in double and float; the carries live in
+//     compensator()). Both lower the round-off floor: Kepler, 100 periods, final position error at the four
+//     tightest tolerances (1.8e-14 .. 3.2e-15), e = 0.5: 8.4e-12, 7.5e-12, 4.8e-13, 3.3e-12 without,
+//     5.5e-13, 2.1e-12, 1.7e-12, 1.5e-12 with; e = 0.9: 1.8e-11, 7.2e-11, 6.7e-12, 4.8e-12 without, 5.3e-13,
+//     3.9e-12, 1.7e-12, 1.2e-12 with. What remains is the rounding of the force and of the increments
+//     themselves (the same tableau in long double with the force rounded to double: 1e-13 .. 6e-13).
 // Force evaluations are counted exactly, rejected steps and the starting-step estimate included.
 // The state and the steps live in the scalar type; the controller's own arithmetic (norms, step
 // ratios) runs in double through as_double, so any type with scalar_traits, epsilon_of, as_double,
@@ -355,8 +362,11 @@ class AdaptiveRknIntegrator {
   using real_type = scalar_type;
   static_assert(!is_complex_v<scalar_type>, "adaptive step control needs a real scalar type");
 
-  AdaptiveRknIntegrator(RknTableau<scalar_type> t, Force force, AdaptiveOptions opt = {})
-      : opt_(opt), stepper_(check(std::move(t)), std::move(force)) {
+  /// eopt.compensated: compensated summation of the accepted increments (automatic: in double and float).
+  AdaptiveRknIntegrator(RknTableau<scalar_type> t, Force force, AdaptiveOptions opt = {}, EngineOptions eopt = {})
+      : opt_(opt),
+        stepper_(check(std::move(t)), std::move(force)),
+        compensated_(use_compensation<scalar_type>(eopt.compensated)) {
     opt_.validate();
     const double min_tol = 10 * as_double(epsilon_of<real_type>());
     if (opt_.tol > 0 && opt_.tol < min_tol)
@@ -371,6 +381,7 @@ class AdaptiveRknIntegrator {
   const AdaptiveOptions& options() const { return opt_; }
   int error_order() const { return opt_.error_order; }
   int method_order() const { return method_order_; }
+  bool compensated() const { return compensated_; }
   const AdaptiveStats& total() const { return total_; }
   Force& force() { return stepper_.force(); }
 
@@ -396,18 +407,45 @@ class AdaptiveRknIntegrator {
     real_type t = t0, h;
     bool error_finite = true;  // the last error estimate was finite (else the force returned NaN or inf)
     State<V> y = s, err;
+    const bool comp = compensated_;
+    Compensator<V> trial;  // the carries of the attempted step; comp_ keeps those of the last accepted one
+    if (comp) {
+      comp_.begin(s);
+      trial = comp_;
+    }
+    // Keeps the state and the carries of the last accepted step (also before an exception).
+    auto store = [&] {
+      if (comp) comp_.end(s);
+    };
     while (t < t1) {
-      if (st.accepted + st.rejected >= opt_.max_steps)
+      if (st.accepted + st.rejected >= opt_.max_steps) {
+        store();
         adaptive_detail::throw_too_many_steps("adaptive RKN", opt_.max_steps, as_double(t), as_double(t1));
+      }
+      // Steps whose end times are exactly representable (the time reached is the sum of the steps, see
+      // StepSequence::next); compensated summation of the increments in double and float, as in the
+      // fixed-step engine: both keep the round-off of 10^4 steps below the error of the state's last bit.
       bool last;
-      if (!seq.template next<false>(t, h, last))
+      if (!seq.template next<true>(t, h, last)) {
+        store();
         adaptive_detail::throw_underflow("adaptive RKN", as_double(t), as_double(h), error_finite);
+      }
       assign_state(y, s);
-      stepper_.step_with_error(y, h, err);
+      if (comp) {
+        assign(trial.cq, comp_.cq);
+        assign(trial.cv, comp_.cv);
+        stepper_.step_with_error(y, h, err, trial);
+      } else {
+        stepper_.step_with_error(y, h, err);
+      }
       const double e = error_norm(s, y, err, err_scale);  // the controller works in double: 2 digits suffice
       error_finite = e < std::numeric_limits<double>::infinity();
       if (e <= 1.0) {
         assign_state(s, y);
+        if (comp) {
+          assign(comp_.cq, trial.cq);
+          assign(comp_.cv, trial.cv);
+        }
         t = last ? t1 : t + h;
         ++st.accepted;
         st.last_h = as_double(h);
@@ -423,6 +461,7 @@ class AdaptiveRknIntegrator {
         seq.rejected(std::pow(e, expo), h);
       }
     }
+    store();
     st.force_evals = stepper_.force_evals() - evals_before + extra_evals;
     total_ += st;
     return st;
@@ -431,11 +470,14 @@ class AdaptiveRknIntegrator {
   /// Forget the step carried over between calls (the next call estimates a first step again).
   void reset() {
     h_next_ = real_type(0);
+    comp_.invalidate();
     resume_.valid = false;
   }
   /// Where the last run stopped at its observer's request (valid == false: it did not stop).
   const AdaptiveResumePoint<real_type>& resume_point() const { return resume_; }
   void set_resume_point(const AdaptiveResumePoint<real_type>& p) { resume_ = p; }
+  /// The compensated-summation carries of the run (checkpoint/restart).
+  Compensator<V>& compensator() { return comp_; }
 
  private:
   static RknTableau<scalar_type> check(RknTableau<scalar_type> t) {
@@ -471,15 +513,18 @@ class AdaptiveRknIntegrator {
   AdaptiveOptions opt_;
   RknStepper<V, Force> stepper_;
   int method_order_ = 0;
+  bool compensated_ = false;
   real_type h_next_ = real_type(0);
   AdaptiveResumePoint<real_type> resume_;
   AdaptiveStats total_;
+  Compensator<V> comp_;
 };
 
 /// Builds an adaptive integrator for a catalog method with embedded weights, at a reference
 /// precision matched to V's scalar type.
 template <class V, class F>
-AdaptiveRknIntegrator<V, F> make_adaptive_integrator(const MethodDef& def, F force, AdaptiveOptions opt = {}) {
+AdaptiveRknIntegrator<V, F> make_adaptive_integrator(const MethodDef& def, F force, AdaptiveOptions opt = {},
+                                                     EngineOptions eopt = {}) {
   using S = typename V::value_type;
   opt.validate();
   // Coefficients at the reference precision; the working values are created outside it (mpfr_real).
@@ -488,7 +533,7 @@ AdaptiveRknIntegrator<V, F> make_adaptive_integrator(const MethodDef& def, F for
   if (!t || t->bhat.empty())
     throw std::invalid_argument("method '" + def.info.name + "' has no embedded pair: it cannot run with a tolerance");
   auto conv = [](const bigcomplex& x) { return to_scalar<S>(x); };
-  return AdaptiveRknIntegrator<V, F>(convert_tableau<S>(*t, conv), std::move(force), opt);
+  return AdaptiveRknIntegrator<V, F>(convert_tableau<S>(*t, conv), std::move(force), opt, eopt);
 }
 
 }  // namespace nystrom

@@ -73,8 +73,11 @@ class RknStepper {
   }
 
   /// One step that also returns the embedded error estimate (q, v) in err (if the tableau has one).
-  /// (Not compensated: step control moves the state between steps.)
+  /// (Not compensated.)
   void step_with_error(State<V>& s, real_type h, State<V>& err) { one_step(s, h, &err, nullptr); }
+  /// The same, the increments added to s with compensated summation with the carries of comp (the caller
+  /// keeps the carries of the last accepted step).
+  void step_with_error(State<V>& s, real_type h, State<V>& err, Compensator<V>& comp) { one_step(s, h, &err, &comp); }
 
  private:
   struct Nz {

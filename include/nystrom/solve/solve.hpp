@@ -856,7 +856,7 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
         auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);
         run_adaptive<VE>(run, engine, "adaptive-mpe", def, sol, events, resume);
       } else {
-        auto engine = make_adaptive_integrator<VE>(def, run.force(), ao);
+        auto engine = make_adaptive_integrator<VE>(def, run.force(), ao, opt.engine);
         run_adaptive<VE>(run, engine, "adaptive-rkn", def, sol, events, resume);
       }
     }
