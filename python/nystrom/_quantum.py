@@ -10,11 +10,12 @@ import numbers
 import numpy as np
 
 from . import _core
+from ._result import AttrDict
 
 __all__ = ["quantum", "QuantumResult"]
 
 
-class QuantumResult(dict):
+class QuantumResult(AttrDict):
     """The result of :func:`nystrom.quantum` (a dict whose keys are also attributes).
 
     Attributes: ``norm``, ``norm_drift`` (final norm minus initial), ``energy`` (<H>, with g|psi|^2/2 for
@@ -28,20 +29,9 @@ class QuantumResult(dict):
     ``method``, ``order``, ``precision``.
     """
 
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError:
-            raise AttributeError(name) from None
-
-    __setattr__ = dict.__setitem__
-
     def __repr__(self):
         return (f"QuantumResult(method={self.method!r}, energy={self.energy!r}, norm={self.norm!r}, "
                 f"time={self.time!r}, fft_count={self.fft_count!r})")
-
-    def __reduce__(self):
-        return (QuantumResult, (dict(self),))
 
 
 def _integer(name, x):

@@ -12,6 +12,7 @@ import os
 import numpy as np
 
 from . import _core
+from ._result import AttrDict
 from ._progress import make_progress
 from .problems import Problem
 
@@ -20,7 +21,7 @@ __all__ = ["solve", "OdeResult", "DenseSolution"]
 _NO_LIMIT = 2**62  # max_steps of a fixed-step run: its number of steps is the caller's choice
 
 
-class OdeResult(dict):
+class OdeResult(AttrDict):
     """The result of :func:`nystrom.solve` (a dict whose keys are also attributes).
 
     Attributes: ``t`` (output times), ``q``, ``v`` (positions and velocities, shape ``(len(t),) +
@@ -34,21 +35,10 @@ class OdeResult(dict):
     ``checkpoint_t`` (the time of the checkpoint written, or None).
     """
 
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError:
-            raise AttributeError(name) from None
-
-    __setattr__ = dict.__setitem__
-
     def __repr__(self):
         keys = ("message", "success", "status", "method", "force_evals", "steps")
         body = ", ".join(f"{k}={self[k]!r}" for k in keys if k in self)
         return f"OdeResult({body}, t: {len(self.get('t', []))} points)"
-
-    def __reduce__(self):
-        return (OdeResult, (dict(self),))
 
 
 class DenseSolution:

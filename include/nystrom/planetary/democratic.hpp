@@ -102,16 +102,8 @@ class DemocraticHeliocentricFlows {
     const std::size_t n = mass_.size();
     R* q = s.data();
     R* v = s.data() + 3 * n;
-    for (int k = 0; k < 3; ++k) q[k] += dt * v[k];
     const R mu = G_ * mass_[0];
-    for (std::size_t i = 1; i < n; ++i) {
-      Vec3<R> qi{q[3 * i], q[3 * i + 1], q[3 * i + 2]}, vi{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-      kepler_drift(mu, dt, qi, vi);
-      for (int k = 0; k < 3; ++k) {
-        q[3 * i + k] = qi[k];
-        v[3 * i + k] = vi[k];
-      }
-    }
+    detail::kepler_drift_bodies(q, v, n, dt, [mu](std::size_t) { return mu; });
     ++drifts_;
   }
 

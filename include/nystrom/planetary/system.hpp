@@ -102,6 +102,21 @@ void jacobi_to_inertial(const std::vector<R>& mass, std::size_t n, In in, Out ou
   out(0, com);
 }
 
+/// The drift of both Wisdom-Holman splittings over a state (x of n bodies, then v; 3 components each): body 0
+/// (the centre of mass, or the barycentre) moves freely, body i >= 1 follows its Kepler orbit of parameter mu(i).
+template <class R, class Mu>
+void kepler_drift_bodies(R* x, R* v, std::size_t n, R dt, Mu mu) {
+  for (int k = 0; k < 3; ++k) x[k] += dt * v[k];
+  for (std::size_t i = 1; i < n; ++i) {
+    Vec3<R> xi{x[3 * i], x[3 * i + 1], x[3 * i + 2]}, vi{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+    kepler_drift(mu(i), dt, xi, vi);
+    for (int k = 0; k < 3; ++k) {
+      x[3 * i + k] = xi[k];
+      v[3 * i + k] = vi[k];
+    }
+  }
+}
+
 }  // namespace detail
 
 /// The flat Jacobi state of a system (see the top of this file).

@@ -72,15 +72,7 @@ class JacobiFlows {
     const std::size_t n = mass_.size();
     R* x = s.data();
     R* v = s.data() + 3 * n;
-    for (int k = 0; k < 3; ++k) x[k] += dt * v[k];  // the centre of mass
-    for (std::size_t i = 1; i < n; ++i) {
-      Vec3<R> xi{x[3 * i], x[3 * i + 1], x[3 * i + 2]}, vi{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-      kepler_drift(mu_[i], dt, xi, vi);
-      for (int k = 0; k < 3; ++k) {
-        x[3 * i + k] = xi[k];
-        v[3 * i + k] = vi[k];
-      }
-    }
+    detail::kepler_drift_bodies(x, v, n, dt, [this](std::size_t i) { return mu_[i]; });
     ++drifts_;
   }
 
