@@ -96,23 +96,15 @@ class DemocraticHeliocentricFlows {
   long kicks() const { return kicks_; }
 
   void apply_a(state_type& s, std::complex<R> z) {
-    if (z.imag() != 0)
-      throw std::invalid_argument("a Kepler drift takes a real time: methods with complex coefficients do not apply");
-    const R dt = z.real();
-    const std::size_t n = mass_.size();
-    R* q = s.data();
-    R* v = s.data() + 3 * n;
     const R mu = G_ * mass_[0];
-    detail::kepler_drift_bodies(q, v, n, dt, [mu](std::size_t) { return mu; });
+    detail::kepler_drift_bodies(s, mass_.size(), detail::real_step(z, "a Kepler drift"),
+                                [mu](std::size_t) { return mu; });
     ++drifts_;
   }
 
   void apply_b(state_type& s, std::complex<R> z) {
-    if (z.imag() != 0)
-      throw std::invalid_argument(
-          "an interaction kick takes a real time: methods with complex coefficients do not apply");
     using std::sqrt;
-    const R dt = z.real();
+    const R dt = detail::real_step(z, "an interaction kick");
     const std::size_t n = mass_.size();
     R* q = s.data();
     R* v = s.data() + 3 * n;

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cmath>
+#include <complex>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -102,10 +103,21 @@ void jacobi_to_inertial(const std::vector<R>& mass, std::size_t n, In in, Out ou
   out(0, com);
 }
 
-/// The drift of both Wisdom-Holman splittings over a state (x of n bodies, then v; 3 components each): body 0
+/// The time of a planetary flow's sub-step: its coefficient times h must be real (what names the flow).
+template <class R>
+R real_step(std::complex<R> z, const char* what) {
+  if (z.imag() != 0)
+    throw std::invalid_argument(std::string(what) +
+                                " takes a real time: methods with complex coefficients do not apply");
+  return z.real();
+}
+
+/// The drift of both Wisdom-Holman splittings over a state s (x of n bodies, then v; 3 components each): body 0
 /// (the centre of mass, or the barycentre) moves freely, body i >= 1 follows its Kepler orbit of parameter mu(i).
 template <class R, class Mu>
-void kepler_drift_bodies(R* x, R* v, std::size_t n, R dt, Mu mu) {
+void kepler_drift_bodies(std::vector<R>& s, std::size_t n, R dt, Mu mu) {
+  R* x = s.data();
+  R* v = s.data() + 3 * n;
   for (int k = 0; k < 3; ++k) x[k] += dt * v[k];
   for (std::size_t i = 1; i < n; ++i) {
     Vec3<R> xi{x[3 * i], x[3 * i + 1], x[3 * i + 2]}, vi{v[3 * i], v[3 * i + 1], v[3 * i + 2]};

@@ -66,22 +66,14 @@ class JacobiFlows {
   long kicks() const { return kicks_; }           // applications of flow B (one force evaluation each)
 
   void apply_a(state_type& s, std::complex<R> z) {
-    if (z.imag() != 0)
-      throw std::invalid_argument("a Kepler drift takes a real time: methods with complex coefficients do not apply");
-    const R dt = z.real();
-    const std::size_t n = mass_.size();
-    R* x = s.data();
-    R* v = s.data() + 3 * n;
-    detail::kepler_drift_bodies(x, v, n, dt, [this](std::size_t i) { return mu_[i]; });
+    detail::kepler_drift_bodies(s, mass_.size(), detail::real_step(z, "a Kepler drift"),
+                                [this](std::size_t i) { return mu_[i]; });
     ++drifts_;
   }
 
   void apply_b(state_type& s, std::complex<R> z) {
-    if (z.imag() != 0)
-      throw std::invalid_argument(
-          "an interaction kick takes a real time: methods with complex coefficients do not apply");
     using std::sqrt;
-    const R dt = z.real();
+    const R dt = detail::real_step(z, "an interaction kick");
     const std::size_t n = mass_.size();
     R* x = s.data();
     R* v = s.data() + 3 * n;
