@@ -214,7 +214,9 @@ class FlowIntegrator {
   using real_type = typename F::real_type;
   using complex_type = std::complex<real_type>;
 
-  explicit FlowIntegrator(const FlowMethod& m) : info_(m.info), impl_(make(m)) {}
+  /// compensated: the multi-product expansions' compensated summation (MpeFlowStepper); splittings ignore it.
+  explicit FlowIntegrator(const FlowMethod& m, Compensation compensated = Compensation::automatic)
+      : info_(m.info), impl_(make(m, compensated)) {}
 
   const MethodInfo& info() const { return info_; }
   bool is_mpe() const { return impl_.index() == 1; }
@@ -238,7 +240,7 @@ class FlowIntegrator {
     return convert_scheme<complex_type>(s, [](const bigcomplex& x) { return to_scalar<complex_type>(x); });
   }
 
-  static Impl make(const FlowMethod& m) {
+  static Impl make(const FlowMethod& m, Compensation compensated) {
     if (const auto* sp = std::get_if<SplittingScheme<bigcomplex>>(&m.data))
       return Impl(std::in_place_index<0>, convert(*sp));
     if (const auto* gp = std::get_if<GradientSplitting>(&m.data)) {
@@ -250,7 +252,7 @@ class FlowIntegrator {
     MpeCoefficients mc;
     mc.k = d.k;
     mc.c = d.c;
-    return Impl(std::in_place_index<1>, d.k, mpe_coefficients_as<real_type>(mc), convert(d.base));
+    return Impl(std::in_place_index<1>, d.k, mpe_coefficients_as<real_type>(mc), convert(d.base), compensated);
   }
 
   MethodInfo info_;
