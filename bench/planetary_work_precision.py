@@ -14,7 +14,7 @@ summary gives the cheapest Wisdom-Holman method, the cheapest direct method and 
 energy error any method reached.
 
     python3 bench/planetary_work_precision.py --tool build/release/src/nystrom [--years 1e5] [--json FILE]
-        [--markdown FILE] [--cache FILE] [--only M1,M2]
+        [--markdown FILE] [--cache FILE] [--only M1,M2] [--only 'SABA(10,6,4)']
 """
 import argparse
 import json
@@ -28,6 +28,13 @@ MAPS = {
     "WH": [20, 5],
     "WHC7": [100, 50, 25],
     "SABA4": [100, 50, 25],
+    # Blanes, Casas, Farres, Laskar, Makazaga & Murua (2013): no eps^2 h^2 term; eps^3 h^4 (or eps^2 h^4) instead
+    "SABA(10,6,4)": [500, 450, 400, 350, 300, 200],
+    "SABAH(10,6,4)": [450, 400, 350, 300, 200],
+    "SABA(8,6,4)": [300, 250, 200, 150],
+    "SABAH(8,6,4)": [300, 250, 200, 150],
+    "SABA(10,4)": [200, 150, 100],
+    "SABAH(8,4,4)": [200, 150, 100],
     "WH-KL8": [300, 200, 100],
     "WH-SS10": [400, 300, 200],
     "WH-M6": [200, 100, 50],
@@ -90,7 +97,9 @@ def main():
     p.add_argument("--tool", required=True, help="the nystrom program (Release build)")
     p.add_argument("--years", type=float, default=1e5)
     p.add_argument("--cache", default="planetary_reference.json", help="reference cache (JSON, keyed by horizon)")
-    p.add_argument("--only", help="comma-separated methods to run (default: all)")
+    p.add_argument("--only", action="append",
+                   help="methods to run, comma-separated or repeated; a value that names a method of the sweep "
+                        "whole (SABA(10,6,4), WH-mpe-vv:1,2,3,4) is not split (default: all)")
     p.add_argument("--json", help="write every run to this file")
     p.add_argument("--markdown", help="write the tables as markdown to this file")
     a = p.parse_args()
@@ -106,10 +115,15 @@ def main():
                                             ["--h", repr(REFERENCE["h"]), "--precision", REFERENCE["precision"]]),
                                     stdout=subprocess.PIPE, text=True)
 
-    only = set(a.only.split(",")) if a.only else None
     jobs = [(m, ["--h", repr(h)], "map") for m, hs in MAPS.items() for h in hs]
     jobs += [(m, ["--h", repr(h)], "direct") for m, hs in DIRECT.items() for h in hs]
     jobs += [(m, ["--h", "100", "--tol", repr(t)], "direct") for m, ts in ADAPTIVE.items() for t in ts]
+    only = None
+    if a.only:
+        known = {j[0] for j in jobs}
+        only = set()
+        for v in a.only:
+            only.update([v] if v in known else v.split(","))
     jobs = [j for j in jobs if only is None or j[0] in only]
 
     rows = []

@@ -55,6 +55,7 @@ std::vector<nystrom::MethodInfo> planetary_maps() {
   for (int n : nystrom::methods::wh_corrector_orders()) names.push_back("WHC" + std::to_string(n));
   for (int n = 1; n <= 4; ++n) names.push_back("SABA" + std::to_string(n));
   for (int n = 1; n <= 4; ++n) names.push_back("SBAB" + std::to_string(n));
+  for (const auto& def : nystrom::methods::blanes_et_al2013()) names.push_back(def.info.name);
   names.push_back("WHD");
   for (const auto& n : names) out.push_back(nystrom::planetary::resolve_wh_method(n, 53, "double").info);
   return out;

@@ -8,10 +8,12 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <gmpxx.h>
 
+#include "nystrom/methods/blanes_et_al2013.hpp"
 #include "nystrom/methods/wisdom_holman_touma1996.hpp"
 #include "nystrom/planetary/kepler_drift.hpp"
 #include "nystrom/planetary/system.hpp"
@@ -492,3 +494,59 @@ TEST(WisdomHolman, CompensatedExpansionKeepsItsCarryAcrossCalls) {
   EXPECT_EQ(s, one);
 }
 
+// The methods of generalized order of Blanes, Casas, Farres, Laskar, Makazaga & Murua (2013), from their
+// published decimals: each is a palindrome whose drifts and kicks sum to 1 (to the digits published).
+TEST(GeneralizedOrder, PublishedCoefficientsAreConsistentAndSymmetric) {
+  const nystrom::BigPrecision guard(256);
+  const auto defs = nystrom::methods::blanes_et_al2013();
+  ASSERT_EQ(defs.size(), 6u);
+  for (const auto& def : defs) {
+    SCOPED_TRACE(def.info.name);
+    const auto sc = std::get<nystrom::SplittingScheme<nystrom::bigcomplex>>(def.build());
+    nystrom::bigfloat a = 0, b = 0;
+    const std::size_t m = sc.steps.size();
+    for (std::size_t i = 0; i < m; ++i) {
+      EXPECT_EQ(sc.steps[i].flow, i % 2 == 0 ? nystrom::Flow::drift : nystrom::Flow::kick);
+      EXPECT_EQ(sc.steps[i].coef.re, sc.steps[m - 1 - i].coef.re);
+      (sc.steps[i].flow == nystrom::Flow::drift ? a : b) += sc.steps[i].coef.re;
+    }
+    // 39 digits; 30 for the kick weights of SABA(8,6,4), which sum to 1 - 5.0e-31 as published
+    const double tol = std::pow(10.0, 1 - def.info.published_digits);
+    EXPECT_LT(static_cast<double>(abs(a - 1)), tol);
+    EXPECT_LT(static_cast<double>(abs(b - 1)), tol);
+    EXPECT_EQ(m, static_cast<std::size_t>(2 * def.info.stages + 1));
+    // the name and its alias without parentheses resolve to the same method
+    EXPECT_EQ(resolve_wh_method(def.info.aliases.at(0), 53, "double").info.name, def.info.name);
+  }
+}
+
+// Their error structure, measured on the two-planet system (relative energy error, long double): at eps = 1e-7
+// the eps h^s1 term dominates (slope 10 for the (10,...) methods, 8 for the (8,...) ones); at eps = 1e-3, the
+// outer solar system's, every one has slope 4 in h, where SABA4 keeps the slope 2 of its eps^2 h^2 term, and an
+// error at least 100 times below SABA4's; in that h^4 regime the error grows as eps^3 for the (s1,6,4) methods
+// (their leading term there is eps^3 h^4) and as eps^2 for SABA(10,4) and SABAH(8,4,4) (eps^2 h^4).
+TEST(GeneralizedOrder, ErrorTermsInThePerturbationAndTheStep) {
+  struct Case {
+    const char* method;
+    double s1;
+    long n;  // steps of the slope at eps = 1e-7 (asymptotic, above the rounding floor)
+    double eps_power;
+  };
+  const PlanetarySystem<LD> small = two_planets<LD>(1e-7), jovian = two_planets<LD>(1e-3);
+  const double saba4 = energy_error_max<LD>(jovian, "SABA4", kT, 128);
+  EXPECT_NEAR(std::log2(energy_error_max<LD>(jovian, "SABA4", kT, 64) / saba4), 2, 0.2);
+  for (const Case& c :
+       {Case{"SABA(10,6,4)", 10, 16, 3}, Case{"SABA(8,6,4)", 8, 32, 3}, Case{"SABA(10,4)", 10, 16, 2},
+        Case{"SABAH(8,4,4)", 8, 32, 2}, Case{"SABAH(8,6,4)", 8, 32, 3}, Case{"SABAH(10,6,4)", 10, 16, 3}}) {
+    SCOPED_TRACE(c.method);
+    EXPECT_NEAR(
+        std::log2(energy_error_max<LD>(small, c.method, kT, c.n) / energy_error_max<LD>(small, c.method, kT, 2 * c.n)),
+        c.s1, 0.7);
+    const double e128 = energy_error_max<LD>(jovian, c.method, kT, 128);
+    EXPECT_NEAR(std::log2(energy_error_max<LD>(jovian, c.method, kT, 64) / e128), 4, 0.25);
+    EXPECT_LT(e128, saba4 / 100);
+    const double lo = energy_error_max<LD>(two_planets<LD>(1.25e-4), c.method, kT, 128);
+    const double hi = energy_error_max<LD>(two_planets<LD>(2.5e-4), c.method, kT, 128);
+    EXPECT_NEAR(std::log2(hi / lo), c.eps_power, 0.4);
+  }
+}

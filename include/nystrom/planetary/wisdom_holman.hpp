@@ -21,6 +21,9 @@
 //                     Chin's multi-product expansion of order 8 over the WH map (the natural sequence 1..4),
 //                     WH-KL8 = Kahan-Li's composition of WH maps, WH-mpe:1,2,3,4,5 (any sequence);
 //   SABA1..4, SBAB1..4 Laskar & Robutel's maps (methods/laskar_robutel2001.hpp);
+//   SABA(10,6,4), SABA(8,6,4), SABA(10,4), SABAH(8,4,4), SABAH(8,6,4), SABAH(10,6,4)  the methods of generalized
+//                     order of Blanes, Casas, Farres, Laskar, Makazaga & Murua (methods/blanes_et_al2013.hpp;
+//                     aliases SABA1064, ...): error O(eps h^10 + eps^2 h^6 + eps^3 h^4) for SABA(10,6,4);
 //   WHC3, WHC5, WHC7, WHC11, WHC17  the map with the symplectic corrector of that order (Wisdom, Holman &
 //                     Touma 1996; methods/wisdom_holman_touma1996.hpp): C before the first step, C^{-1} applied
 //                     to a copy at every output, error O(eps h^{n+1} + eps^2 h^2).
@@ -41,6 +44,7 @@
 #include <vector>
 
 #include "nystrom/core/scalar.hpp"
+#include "nystrom/methods/blanes_et_al2013.hpp"
 #include "nystrom/methods/laskar_robutel2001.hpp"
 #include "nystrom/methods/wisdom_holman_touma1996.hpp"
 #include "nystrom/operators/flow_methods.hpp"
@@ -149,8 +153,11 @@ inline operators::FlowMethod resolve_wh_method(const std::string& spec, long bit
                        ": error O(eps h^" + std::to_string(n + 1) + " + eps^2 h^2) for H = A + eps B";
     return {info, position_verlet_scheme()};
   }
-  for (const MethodDef& def : methods::laskar_robutel2001())
-    if (def.info.name == spec) {
+  std::vector<MethodDef> named = methods::laskar_robutel2001();
+  for (MethodDef& def : methods::blanes_et_al2013()) named.push_back(std::move(def));
+  for (const MethodDef& def : named)
+    if (def.info.name == spec ||
+        std::find(def.info.aliases.begin(), def.info.aliases.end(), spec) != def.info.aliases.end()) {
       auto sc = std::get<SplittingScheme<bigcomplex>>(method_data_for(def, bits, type_name));
       MethodInfo info = def.info;
       info.forces_per_step = info.stages = normalized(sc).forces_per_step();
@@ -188,8 +195,8 @@ inline operators::FlowMethod resolve_wh_method(const std::string& spec, long bit
   }
   throw std::invalid_argument(
       "unknown planetary method '" + spec +
-      "': use WH, WH-<catalog method> (e.g. WH-M8), WHC3..WHC17, SABA1..SABA4, SBAB1..SBAB4, WHD or " +
-      "WHD-<catalog method>");
+      "': use WH, WH-<catalog method> (e.g. WH-M8), WHC3..WHC17, SABA1..SABA4, SBAB1..SBAB4, " +
+      "SABA(10,6,4), SABA(8,6,4), SABA(10,4), SABAH(8,4,4), SABAH(8,6,4), SABAH(10,6,4), WHD or WHD-<catalog method>");
 }
 
 /// What a run observes: called before the first step and after every `every` steps (and after the last).
