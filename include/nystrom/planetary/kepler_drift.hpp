@@ -231,19 +231,19 @@ void kepler_drift_short(std::size_t count, R dt, Mu mu, R* x, R* v, bool* done) 
   using std::sqrt;
   const StumpffTable<R>& table = StumpffTable<R>::get();
   const R eps = std::numeric_limits<R>::epsilon();
-  std::array<R, kKeplerBatch> r0, eta0, beta, zeta0, s, g0, g1, g2, g3, f, r;
+  std::array<R, kKeplerBatch> r0, inv_r0, eta0, beta, zeta0, s, g0, g1, g2, g3, f, r;
   std::array<bool, kKeplerBatch> ok;
   for (std::size_t k = 0; k < count; ++k) {  // the orbit and the cubic guess
     const R* xk = x + 3 * k;
     const R* vk = v + 3 * k;
     const R m = mu(k);
     r0[k] = sqrt(xk[0] * xk[0] + xk[1] * xk[1] + xk[2] * xk[2]);
-    const R inv_r0 = 1 / r0[k];
+    inv_r0[k] = 1 / r0[k];
     eta0[k] = xk[0] * vk[0] + xk[1] * vk[1] + xk[2] * vk[2];
-    beta[k] = 2 * m * inv_r0 - (vk[0] * vk[0] + vk[1] * vk[1] + vk[2] * vk[2]);
+    beta[k] = 2 * m * inv_r0[k] - (vk[0] * vk[0] + vk[1] * vk[1] + vk[2] * vk[2]);
     zeta0[k] = m - beta[k] * r0[k];
-    const R u = dt * inv_r0;
-    const R a2 = -eta0[k] * inv_r0 / 2, a3 = (eta0[k] * eta0[k] * inv_r0 / 2 - zeta0[k] / 6) * inv_r0;
+    const R u = dt * inv_r0[k];
+    const R a2 = -eta0[k] * inv_r0[k] / 2, a3 = (eta0[k] * eta0[k] * inv_r0[k] / 2 - zeta0[k] / 6) * inv_r0[k];
     s[k] = u * (1 + u * (a2 + u * a3));
     // the series where its terms are small, over less than a quarter of an ellipse (no reduction modulo the
     // period); false for a non-finite or collision orbit
@@ -288,10 +288,10 @@ void kepler_drift_short(std::size_t count, R dt, Mu mu, R* x, R* v, bool* done) 
     done[k] = ok[k];
     if (!ok[k]) continue;
     const R m = mu(k);
-    const R inv_r0 = 1 / r0[k], inv_r = 1 / r[k];
-    const R fm1 = -m * g2[k] * inv_r0;
+    const R inv_r = 1 / r[k];
+    const R fm1 = -m * g2[k] * inv_r0[k];
     const R g = r0[k] * g1[k] + eta0[k] * g2[k];
-    const R fdot = -m * g1[k] * inv_r * inv_r0;
+    const R fdot = -m * g1[k] * inv_r * inv_r0[k];
     const R gdm1 = -m * g2[k] * inv_r;
     R* xk = x + 3 * k;
     R* vk = v + 3 * k;
