@@ -207,6 +207,138 @@ TEST(KeplerDrift, RefusesACollisionOrbit) {
   EXPECT_THROW(kepler_drift(1.0, 1.0, x, v), std::invalid_argument);
 }
 
+// The short-drift path (cubic guess, Halley steps moving the G-functions by the addition theorems) on the outer
+// solar system's Jacobi orbits: taken for every drift at h = 25..400 days, and equal to the bracketed iteration
+// (the general path, which evaluates the G-functions afresh at every iterate) to a few units of rounding.
+TEST(KeplerDrift, ShortDriftPathAgreesWithTheBracketedIteration) {
+  const PlanetarySystem<double> sys = outer_solar_system<double>();
+  const std::vector<double> s0 = to_jacobi(sys);
+  const std::vector<double> mu = jacobi_kepler_mu(sys.G, sys.mass);
+  const std::size_t n = sys.size();
+  for (double h : {25.0, -50.0, 200.0, 400.0}) {
+    std::vector<double> s = s0;
+    for (int step = 0; step < 200; ++step)
+      for (std::size_t i = 1; i < n; ++i) {
+        Vec3<double> xb{s[3 * i], s[3 * i + 1], s[3 * i + 2]},
+            vb{s[3 * n + 3 * i], s[3 * n + 3 * i + 1], s[3 * n + 3 * i + 2]};
+        const Vec3<double> x0 = xb, v0 = vb;
+        detail::kepler_drift_bracketed(mu[i], h, xb, vb);
+        bool done = false;
+        detail::kepler_drift_short<double>(
+            1, h, [&](std::size_t) { return mu[i]; }, &s[3 * i], &s[3 * n + 3 * i], &done);
+        ASSERT_TRUE(done) << "h = " << h << " planet " << i << " step " << step;
+        const Vec3<double> x{s[3 * i], s[3 * i + 1], s[3 * i + 2]},
+            v{s[3 * n + 3 * i], s[3 * n + 3 * i + 1], s[3 * n + 3 * i + 2]};
+        // the increments (f - 1) x0 + g v0 are exact to rounding in both: compare them with their size
+        EXPECT_LT(distance(x, xb), 16 * kEps * (norm3(x0) + std::fabs(h) * norm3(v0))) << "h = " << h << " i = " << i;
+        EXPECT_LT(distance(v, vb), 16 * kEps * norm3(v0)) << "h = " << h << " i = " << i;
+      }
+  }
+}
+
+namespace {
+
+/// A mixture of orbits for the batched drift: elliptic (short and over many periods), nearly parabolic,
+/// hyperbolic (a long drift far out), and ones the short-drift path declines.
+struct Orbit {
+  double mu;
+  Vec3<double> x, v;
+};
+std::vector<Orbit> mixed_orbits() {
+  std::vector<Orbit> o;
+  for (double e : {0.0, 0.05, 0.3, 0.9, 1 - 1e-9, 1.0, 1.5, 10.0}) {
+    const Vec3<double> v = pericentre_velocity(e, 0.7);
+    o.push_back({1.0, {0.7, 0.01, -0.02}, {0.03, v[1], 0.05}});
+    o.push_back({2.5, {-0.3, 0.9, 0.2}, {-v[1], 0.1, 0.02}});
+  }
+  return o;
+}
+
+}  // namespace
+
+// Determinism: kepler_drift_many gives every orbit the bits kepler_drift gives it, whichever orbits share its
+// batch and in whichever order, for short and long drifts (the short-drift path, the general path, both).
+TEST(KeplerDrift, ManyOrbitsAtOnceGiveTheBitsOfEachAlone) {
+  const std::vector<Orbit> orbits = mixed_orbits();
+  for (double dt : {0.01, 0.3, -0.7, 40.0, 1e4}) {
+    std::vector<Vec3<double>> xs, vs;  // one at a time
+    for (const Orbit& o : orbits) {
+      Vec3<double> x = o.x, v = o.v;
+      kepler_drift(o.mu, dt, x, v);
+      xs.push_back(x);
+      vs.push_back(v);
+    }
+    for (int order = 0; order < 2; ++order) {  // as listed, then reversed (other batch neighbours)
+      const std::size_t m = orbits.size();
+      std::vector<double> x(3 * m), v(3 * m), mu(m);
+      auto at = [&](std::size_t k) { return order == 0 ? k : m - 1 - k; };
+      for (std::size_t k = 0; k < m; ++k) {
+        mu[k] = orbits[at(k)].mu;
+        for (int c = 0; c < 3; ++c) {
+          x[3 * k + c] = orbits[at(k)].x[c];
+          v[3 * k + c] = orbits[at(k)].v[c];
+        }
+      }
+      kepler_drift_many<double>(
+          m, dt, [&](std::size_t k) { return mu[k]; }, x.data(), v.data());
+      for (std::size_t k = 0; k < m; ++k)
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(x[3 * k + c], xs[at(k)][c]) << "dt = " << dt << " orbit " << at(k);
+          EXPECT_EQ(v[3 * k + c], vs[at(k)][c]) << "dt = " << dt << " orbit " << at(k);
+        }
+    }
+  }
+}
+
+// Short and long drifts of the mixed orbits against long double, through the batch: exact to rounding whichever
+// path each orbit takes; dt = 0 leaves every bit unchanged; a collision orbit in a batch is refused.
+TEST(KeplerDrift, ManyOrbitsAtOnceMatchLongDouble) {
+  const std::vector<Orbit> orbits = mixed_orbits();
+  const std::size_t m = orbits.size();
+  for (double dt : {0.0, 1e-3, 0.5, -3.0, 200.0}) {
+    std::vector<double> x(3 * m), v(3 * m);
+    for (std::size_t k = 0; k < m; ++k)
+      for (int c = 0; c < 3; ++c) {
+        x[3 * k + c] = orbits[k].x[c];
+        v[3 * k + c] = orbits[k].v[c];
+      }
+    kepler_drift_many<double>(
+        m, dt, [&](std::size_t k) { return orbits[k].mu; }, x.data(), v.data());
+    for (std::size_t k = 0; k < m; ++k) {
+      const Vec3<double> xd{x[3 * k], x[3 * k + 1], x[3 * k + 2]}, vd{v[3 * k], v[3 * k + 1], v[3 * k + 2]};
+      if (dt == 0) {
+        EXPECT_EQ(xd, orbits[k].x);
+        EXPECT_EQ(vd, orbits[k].v);
+        continue;
+      }
+      Vec3<LD> xl{orbits[k].x[0], orbits[k].x[1], orbits[k].x[2]}, vl{orbits[k].v[0], orbits[k].v[1], orbits[k].v[2]};
+      kepler_drift<LD>(orbits[k].mu, dt, xl, vl);
+      // over many periods the rounding of the mean motion shifts the phase by about eps n dt
+      const double bound = 100 * kEps * (1 + std::fabs(dt));
+      EXPECT_LT(distance(xd, xl), bound * (norm3(xl) + 1)) << "dt = " << dt << " orbit " << k;
+      EXPECT_LT(distance(vd, vl), bound * (norm3(vl) + 1)) << "dt = " << dt << " orbit " << k;
+    }
+  }
+  std::vector<double> x = {1, 0, 0, 0, 0, 0}, v = {0, 1, 0, 1, 0, 0};
+  EXPECT_THROW(kepler_drift_many<double>(
+                   2, 0.1, [](std::size_t) { return 1.0; }, x.data(), v.data()),
+               std::invalid_argument);
+}
+
+// A drift after a kick that changed the orbit (as in a map: drift, kick, drift) is the drift of the new orbit:
+// nothing of the previous orbit is reused. Against the analytic ellipse of the kicked state.
+TEST(KeplerDrift, DriftAfterAKickFollowsTheNewOrbit) {
+  Vec3<double> x{0.9, 0, 0}, v = pericentre_velocity(0.1, 0.9);
+  kepler_drift(1.0, 0.4, x, v);
+  for (int c = 0; c < 2; ++c) v[c] *= 1.2;  // the kick: a more eccentric ellipse (e about 0.6)
+  const Vec3<double> x1 = x, v1 = v;
+  kepler_drift(1.0, 0.4, x, v);
+  Vec3<LD> xr, vr;
+  elliptic_analytic(1, {x1[0], x1[1], 0}, {v1[0], v1[1], 0}, 0.4L, xr, vr);
+  EXPECT_LT(distance(x, xr), 16 * kEps);
+  EXPECT_LT(distance(v, vr), 16 * kEps * norm3(vr));
+}
+
 // ---- Jacobi coordinates ---------------------------------------------------------------------------------------
 
 TEST(Jacobi, RoundTripAndDiagonalKineticEnergy) {

@@ -86,12 +86,18 @@ void inertial_to_jacobi(const std::vector<R>& mass, std::size_t n, In in, Out ou
   out(0, com);
 }
 
-/// The inverse map: inertial vectors from Jacobi ones.
-template <class R, class In, class Out>
-void jacobi_to_inertial(const std::vector<R>& mass, std::size_t n, In in, Out out) {
-  std::vector<R> eta(n);
+/// The interior masses eta_i = m_0 + ... + m_i.
+template <class R>
+std::vector<R> interior_masses(const std::vector<R>& mass) {
+  std::vector<R> eta(mass.size());
   eta[0] = mass[0];
-  for (std::size_t i = 1; i < n; ++i) eta[i] = eta[i - 1] + mass[i];
+  for (std::size_t i = 1; i < mass.size(); ++i) eta[i] = eta[i - 1] + mass[i];
+  return eta;
+}
+
+/// The inverse map: inertial vectors from Jacobi ones, with the interior masses eta given (no allocation).
+template <class R, class In, class Out>
+void jacobi_to_inertial(const std::vector<R>& mass, const std::vector<R>& eta, std::size_t n, In in, Out out) {
   Vec3<R> com = in(0);  // centre of mass of bodies 0..i
   for (std::size_t i = n - 1; i >= 1; --i) {
     const Vec3<R> j = in(i);
@@ -101,6 +107,12 @@ void jacobi_to_inertial(const std::vector<R>& mass, std::size_t n, In in, Out ou
     out(i, xi);
   }
   out(0, com);
+}
+
+/// The inverse map: inertial vectors from Jacobi ones.
+template <class R, class In, class Out>
+void jacobi_to_inertial(const std::vector<R>& mass, std::size_t n, In in, Out out) {
+  jacobi_to_inertial<R>(mass, interior_masses(mass), n, in, out);
 }
 
 /// The time of a planetary flow's sub-step: its coefficient times h must be real (what names the flow).
@@ -119,14 +131,8 @@ void kepler_drift_bodies(std::vector<R>& s, std::size_t n, R dt, Mu mu) {
   R* x = s.data();
   R* v = s.data() + 3 * n;
   for (int k = 0; k < 3; ++k) x[k] += dt * v[k];
-  for (std::size_t i = 1; i < n; ++i) {
-    Vec3<R> xi{x[3 * i], x[3 * i + 1], x[3 * i + 2]}, vi{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-    kepler_drift(mu(i), dt, xi, vi);
-    for (int k = 0; k < 3; ++k) {
-      x[3 * i + k] = xi[k];
-      v[3 * i + k] = vi[k];
-    }
-  }
+  kepler_drift_many<R>(
+      n - 1, dt, [&](std::size_t k) { return mu(k + 1); }, x + 3, v + 3);
 }
 
 }  // namespace detail

@@ -61,7 +61,8 @@ class JacobiFlows {
   using state_type = std::vector<R>;
   using real_type = R;
 
-  JacobiFlows(R G, std::vector<R> mass) : G_(G), mass_(std::move(mass)), mu_(jacobi_kepler_mu(G_, mass_)) {}
+  JacobiFlows(R G, std::vector<R> mass)
+      : G_(G), mass_(std::move(mass)), mu_(jacobi_kepler_mu(G_, mass_)), eta_(detail::interior_masses(mass_)) {}
 
   std::size_t bodies() const { return mass_.size(); }
   const std::vector<R>& masses() const { return mass_; }
@@ -83,7 +84,7 @@ class JacobiFlows {
     R* v = s.data() + 3 * n;
     pos_.resize(n);
     detail::jacobi_to_inertial<R>(
-        mass_, n,
+        mass_, eta_, n,
         [&](std::size_t i) {
           return i == 0 ? Vec3<R>{0, 0, 0} : Vec3<R>{x[3 * i], x[3 * i + 1], x[3 * i + 2]};
         },
@@ -113,8 +114,8 @@ class JacobiFlows {
 
  private:
   R G_;
-  std::vector<R> mass_, mu_;
-  std::vector<Vec3<R>> pos_, acc_;  // scratch of the kick
+  std::vector<R> mass_, mu_, eta_;  // eta_: interior masses m_0 + ... + m_i
+  std::vector<Vec3<R>> pos_, acc_;  // scratch of the kick (allocated by the first one)
   long drifts_ = 0, kicks_ = 0;
 };
 
