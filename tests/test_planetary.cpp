@@ -99,6 +99,28 @@ TEST(KeplerDrift, StumpffFunctionsMatchTheirClosedForms) {
   EXPECT_DOUBLE_EQ(z.c3, 1.0 / 6.0);
 }
 
+// In double, across the ranges where the series takes fewer terms (|x| small) and around the quartering threshold
+// 0.1 (beyond it, the quadruple-argument identities amplify the rounding: the test above): against the series
+// summed term by term in long double with every term down to 1e-30.
+TEST(KeplerDrift, StumpffFunctionsInDoubleMatchTheSeries) {
+  for (double x : {1e-9, -3e-7, 2e-5, -4e-4, 1e-3, -0.0123, 0.05, 0.0999, -0.1001, 0.12}) {
+    LD ref[4] = {0, 0, 0, 0};
+    for (int k = 0; k < 4; ++k) {
+      LD term = 1;  // (-x)^j / (2j + k)!
+      for (int f = 2; f <= k; ++f) term /= f;
+      for (int j = 0; j < 40 && std::fabs(static_cast<double>(term)) > 1e-30; ++j) {
+        ref[k] += term;
+        term *= -LD(x) / ((2 * j + k + 1) * LD(2 * j + k + 2));
+      }
+    }
+    const Stumpff<double> c = stumpff(x);
+    const double got[4] = {c.c0, c.c1, c.c2, c.c3};
+    for (int k = 0; k < 4; ++k)
+      EXPECT_NEAR(got[k], static_cast<double>(ref[k]), 4 * kEps * std::fabs(static_cast<double>(ref[k])))
+          << "x = " << x << " c" << k;
+  }
+}
+
 // One drift across a million orbits: the only error is the rounding of the mean motion times the time,
 // eps n t, which the analytic formula evaluated in double has too.
 TEST(KeplerDrift, MatchesTheEllipticSolutionOverAMillionOrbits) {
