@@ -173,7 +173,8 @@ void kepler_drift_bracketed(R mu, R dt, Vec3<R>& x, Vec3<R>& v) {
     const R fpp = eta0 * g0 + zeta0 * g1;
     if (converged) break;  // one evaluation at the converged s for the G-functions
     // F at the level of its own rounding: s is as good as this precision allows
-    if (std::isfinite(static_cast<double>(f)) &&
+    // (and F, r representable: G-functions that overflow make the bound infinite)
+    if (std::isfinite(static_cast<double>(f)) && std::isfinite(static_cast<double>(r)) &&
         abs(f) <= 4 * eps * (abs(r0 * s) + abs(eta0 * g2) + abs(zeta0 * g3) + abs(t))) {
       converged = true;
       break;
