@@ -22,12 +22,13 @@
 //   G0(s+d) = G0 G0(d) - beta G1 G1(d),  G1(s+d) = G1 G0(d) + G0 G1(d),
 //   G2(s+d) = G2 + G2(d) + G1 G1(d) - beta G2 G2(d),  G3(s+d) = G3 + G3(d) + G1 G2(d) + G2 G1(d)
 // (G(d) by a two- or three-term series, |d| <= |s| / 64) instead of evaluating them anew. It is taken when the
-// series' terms are small, beta s^2 <= 2.5 (less than a quarter of an ellipse) and F at the last iterate is at the
+// series' terms are small, |beta s^2| <= 2.5 (less than a quarter of an ellipse) and F at the last iterate is at the
 // level of its own rounding, the acceptance test of the general path; otherwise the general path runs from the
 // start: an elliptic drift longer than one period reduced modulo the period, Laguerre-Conway iteration (n = 5)
 // from the quadratic series (or the mean motion for long elliptic drifts), kept inside a bracket of the root that
 // shrinks with every evaluation (F is increasing: F' = r > 0), bisection when a step leaves it or fails to reduce
-// |F| 64-fold (Laguerre steps reduce it far more near a root), the G-functions evaluated afresh at every iterate.
+// |F| 64-fold (Laguerre steps reduce it far more near a root), the G-functions evaluated afresh at every iterate;
+// where they overflow (a far guess on a hyperbola) the bracket shrinks on the side of s and the search goes on.
 // No state is kept between drifts: the path and the result depend on the arguments only, and kepler_drift_many
 // gives every orbit the bits kepler_drift gives it (tests/test_planetary.cpp).
 //
@@ -173,7 +174,8 @@ void kepler_drift_bracketed(R mu, R dt, Vec3<R>& x, Vec3<R>& v) {
     const R fpp = eta0 * g0 + zeta0 * g1;
     if (converged) break;  // one evaluation at the converged s for the G-functions
     // F at the level of its own rounding: s is as good as this precision allows
-    if (std::isfinite(static_cast<double>(f)) &&
+    // (and F, r representable: G-functions that overflow make the bound infinite)
+    if (std::isfinite(static_cast<double>(f)) && std::isfinite(static_cast<double>(r)) &&
         abs(f) <= 4 * eps * (abs(r0 * s) + abs(eta0 * g2) + abs(zeta0 * g3) + abs(t))) {
       converged = true;
       break;
