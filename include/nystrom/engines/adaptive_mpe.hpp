@@ -184,8 +184,8 @@ class AdaptiveMpeIntegrator {
   /// Order control: the accepted steps of all calls so far by the order of the solution they propagated
   /// (index: the order 2n; size 2N + 1). Empty for one order per run.
   const std::vector<long>& order_histogram() const { return hist_; }
-  /// Order control: steps rejected after the products of order 2n - 2 alone, before the last force of the
-  /// longest product (their estimate made an accepted step of order 2n hopeless).
+  /// Order control: steps rejected after the products of order 2n - 2 alone, before the last pair of the
+  /// longest product (their estimate was not finite: the force returned NaN or inf).
   long early_rejections() const { return early_rejected_; }
   Force& force() { return base_.force(); }
   /// Force evaluations of all calls so far (the starting-step estimates included).
@@ -687,17 +687,22 @@ class AdaptiveMpeIntegrator {
   // sub-step, so that products 1..n-1 are complete one pair before product n. Then the convergence monitor:
   //   * err_{n-1}, the estimate of T_{2n-2} - T_{2n-4} (products 1..n-1, free), <= 1: the step is accepted with
   //     T_{2n-2}, without the last force(s) of product n;
-  //   * the estimate of err_n predicted from err_{n-1} and the ratio err_n / err_{n-1} of the last full step of
-  //     n products (scaled by (h / h_then)^2, one order of h^2 between the two) above 4: the step is rejected
-  //     at once (hopeless; a step of target n whose err_n is at 4 would be rejected);
+  //   * err_{n-1} not finite (the force returned NaN or inf): the step is rejected at once;
   //   * else product n completes, and the step is accepted with T_2n when err_n <= 1.
   // Then order and step: H_j = h * ratio_j (the step ratio of order j by the controller of the fixed-order
   // engine, adaptive_detail::StepController, one per order, Gustafsson's predictive ratio included) for the
-  // order j of the solution taken and j - 1, the work per unit step W_j = A_j / H_j (A_j: the force evaluations
-  // of a step of j products), and the next target is j - 1 when W_{j-1} < 0.8 W_j, else j + 1 with step
-  // H_j A_{j+1} / A_j when W_j < 0.9 W_{j-1} and the step was accepted (HNW I, eqs (9.25)-(9.28) with the
-  // orders of the products in place of the columns), else j. A target of two products has no lower estimate;
-  // it moves up when its step ratio is at fac_max. The error scale, its noise floor (per n), the exact ends,
+  // order j of the solution taken and j - 1, the work per unit step W_j = A_j / H_j, and the next target is
+  // j - 1 when W_{j-1} < 0.7 W_j, else j + 1 with step H_j A_{j+1} / A_j when W_j < W_{j-1} and the step was
+  // accepted (HNW I, eqs (9.25)-(9.28) with the orders of the products in place of the columns), else j.
+  // A_n = n + 3: the time of a lockstep step of n products is set by its chain of n forces, not by its
+  // n(n+1)/2 forces (measured on Kepler e = 0.9, fixed-order steps of 4..8 products: about (n + 2.7) x 26 ns);
+  // with A_n = n(n+1)/2, as ODEX counts, the controller chose orders 8-12 where M14/M16 are faster. The factors
+  // 0.7 and 1.0 instead of ODEX's 0.8 and 0.9: fewer order changes (tol 1e-9, e = 0.9: 0.99 ms with 0.8 and 0.9,
+  // 0.82 ms with 0.7 and 1.0, at a final error of 7e-6 and 1.2e-5).
+  // ODEX's early rejection of a hopeless step (err_n predicted from err_{n-1} and the last ratio err_n /
+  // err_{n-1}) rejected steps that would have passed: at tol 1e-12, e = 0.9, rejections 201 -> 529 and 18%
+  // more time; it saves one pair of one product, so it is left out. A target of two products has no lower
+  // estimate; it moves up when its step ratio is at fac_max. The error scale, its noise floor (per n), the exact ends,
   // the compensated increments and the force counts are those of the fixed-order engine.
 
   void setup_order_control(MpeOrderTables<scalar_type> orders) {
@@ -731,17 +736,40 @@ class AdaptiveMpeIntegrator {
     for (std::size_t n = 1; n <= N + 1; ++n) work_[n] = static_cast<double>(n) + 3;
   }
 
-  // The products k = 1..N of a step from s in increment form (x[r]: k = r + 1), products 1..N-1 complete
-  // before the last pair of product N; between the two, check() (true: go on). The same operations per product
-  // as trial_verlet (bitwise the same increments). Returns the forces evaluated.
-  template <class Count, class XS, class AS, class Check>
-  NYSTROM_ALWAYS_INLINE long oc_products(Count N, const State<V>& s, const V& a0, const real_type& h, XS& x, AS& a,
-                                         Check&& check) {
+  // The increments and forces of the products of one step: local arrays for fixed-size states (nothing of the
+  // step in memory that the force functor could alias, as in trial_verlet: the unrolled step keeps them in
+  // registers; measured on Kepler e = 0.9, the products in std::array<State<V>, 8> made a step twice as slow)
+  // or the member buffers.
+  struct LocalProducts {
+    static constexpr std::size_t D = fixed_lockstep ? std::tuple_size<V>::value : 1;
+    scalar_type dq[8][D], dv[8][D], a[8][D];
+    scalar_type& q(std::size_t r, std::size_t j) { return dq[r][j]; }
+    scalar_type& v(std::size_t r, std::size_t j) { return dv[r][j]; }
+    scalar_type& acc(std::size_t r, std::size_t j) { return a[r][j]; }
+    const scalar_type& q(std::size_t r, std::size_t j) const { return dq[r][j]; }
+    const scalar_type& v(std::size_t r, std::size_t j) const { return dv[r][j]; }
+  };
+  struct MemberProducts {
+    std::vector<State<V>>& x;
+    std::vector<V>& as;
+    scalar_type& q(std::size_t r, std::size_t j) { return x[r].q[j]; }
+    scalar_type& v(std::size_t r, std::size_t j) { return x[r].v[j]; }
+    scalar_type& acc(std::size_t r, std::size_t j) { return as[r][j]; }
+    const scalar_type& q(std::size_t r, std::size_t j) const { return x[r].q[j]; }
+    const scalar_type& v(std::size_t r, std::size_t j) const { return x[r].v[j]; }
+  };
+
+  // The products k = 1..N of a step from s in increment form (product r: k = r + 1), products 1..N-1 complete
+  // before the last pair of product N; then check(x) (true: go on), and after product N done(x). The same
+  // operations per product as trial_verlet (bitwise the same increments). Returns the forces evaluated.
+  template <class Count, class XS, class Check, class Done>
+  NYSTROM_ALWAYS_INLINE long oc_products(Count N, const State<V>& s, const V& a0, const real_type& h, XS& x,
+                                         Check&& check, Done&& done) {
     const std::size_t n = s.q.size();
     const auto& st = base_.scheme().steps;
     const scalar_type b0 = st[0].coef, b1 = st[1].coef, b2 = st[2].coef;
     const bool kick_first = kick_first_;
-    constexpr bool local = is_std_array<V>::value;
+    constexpr bool local = std::is_same_v<XS, LocalProducts>;
     std::conditional_t<local, V, V&> qt = qbuf_;
     resize_like(qt, s.q);
     scalar_type c0[8], c1[8], c2[8], cm[8];
@@ -752,28 +780,29 @@ class AdaptiveMpeIntegrator {
       c2[r] = b2 * hk;
       cm[r] = c2[r] + c0[r];
       for (std::size_t j = 0; j < n; ++j) {
-        x[r].q[j] = scalar_type(0);
-        x[r].v[j] = scalar_type(0);
-        a[r][j] = kick_first ? a0[j] : scalar_type(0);
+        x.q(r, j) = scalar_type(0);
+        x.v(r, j) = scalar_type(0);
+        x.acc(r, j) = kick_first ? a0[j] : scalar_type(0);
       }
     }
     long evals = 0;
     auto force = [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
       if constexpr (local) {
-        V q;  // a fresh local per call: no false dependence between the products' chains
-        for (std::size_t j = 0; j < n; ++j) q[j] = s.q[j] + x[r].q[j];
-        base_.force()(q, a[r]);
+        V q, ar;  // fresh locals per call: no false dependence between the products' chains
+        for (std::size_t j = 0; j < n; ++j) q[j] = s.q[j] + x.q(r, j);
+        base_.force()(q, ar);
+        for (std::size_t j = 0; j < n; ++j) x.acc(r, j) = ar[j];
       } else {
-        for (std::size_t j = 0; j < n; ++j) qt[j] = s.q[j] + x[r].q[j];
-        base_.force()(qt, a[r]);
+        for (std::size_t j = 0; j < n; ++j) qt[j] = s.q[j] + x.q(r, j);
+        base_.force()(qt, x.as[r]);
       }
       ++evals;
     };
     auto drift = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
-      for (std::size_t j = 0; j < n; ++j) x[r].q[j] += c * (s.v[j] + x[r].v[j]);
+      for (std::size_t j = 0; j < n; ++j) x.q(r, j) += c * (s.v[j] + x.v(r, j));
     };
     auto kick = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
-      for (std::size_t j = 0; j < n; ++j) x[r].v[j] += c * a[r][j];
+      for (std::size_t j = 0; j < n; ++j) x.v(r, j) += c * x.acc(r, j);
     };
     auto pair = [&](std::size_t r, std::size_t p) NYSTROM_ALWAYS_INLINE {
       if (kick_first) {
@@ -799,9 +828,11 @@ class AdaptiveMpeIntegrator {
       for (std::size_t r = top + 1; r-- > p;) pair(r, p);  // the products with k > p, the longest first
       finish(p);                                           // product k = p + 1 has made its k pairs
     }
-    if (!check()) return evals;
-    pair(top, top);
-    finish(top);
+    if (check(static_cast<const XS&>(x))) {
+      pair(top, top);
+      finish(top);
+    }
+    done(static_cast<const XS&>(x));
     return evals;
   }
 
@@ -821,7 +852,7 @@ class AdaptiveMpeIntegrator {
     for (std::size_t i = 0; i < ref; ++i) {
       const scalar_type ci = c[i], di = d[i];
       for (std::size_t j = 0; j < n; ++j) {
-        const scalar_type eq = x[i].q[j] - x[ref].q[j], ev = x[i].v[j] - x[ref].v[j];
+        const scalar_type eq = x.q(i, j) - x.q(ref, j), ev = x.v(i, j) - x.v(ref, j);
         inc.q[j] += ci * eq;
         inc.v[j] += ci * ev;
         err.q[j] += di * eq;
@@ -829,8 +860,8 @@ class AdaptiveMpeIntegrator {
       }
     }
     for (std::size_t j = 0; j < n; ++j) {
-      inc.q[j] += x[ref].q[j];
-      inc.v[j] += x[ref].v[j];
+      inc.q[j] += x.q(ref, j);
+      inc.v[j] += x.v(ref, j);
     }
   }
 
@@ -845,22 +876,24 @@ class AdaptiveMpeIntegrator {
     return std::max(nmin_target(), std::min(nmax_, n));
   }
 
-  // The products of one step (the storage of the products: local arrays or the member buffers).
-  template <class XS, class AS, class Check>
-  NYSTROM_ALWAYS_INLINE long oc_dispatch(int nprod, const State<V>& s, const V& a0, const real_type& h, XS& x, AS& a,
-                                         Check&& check) {
+  // The products of one step, unrolled for fixed-size states (see LocalProducts).
+  template <class Check, class Done>
+  NYSTROM_ALWAYS_INLINE long oc_dispatch(int nprod, const State<V>& s, const V& a0, const real_type& h, Check&& check,
+                                         Done&& done) {
     if constexpr (fixed_lockstep) {
+      LocalProducts x;
       switch (nprod) {
-        case 2: return oc_products(std::integral_constant<std::size_t, 2>{}, s, a0, h, x, a, check);
-        case 3: return oc_products(std::integral_constant<std::size_t, 3>{}, s, a0, h, x, a, check);
-        case 4: return oc_products(std::integral_constant<std::size_t, 4>{}, s, a0, h, x, a, check);
-        case 5: return oc_products(std::integral_constant<std::size_t, 5>{}, s, a0, h, x, a, check);
-        case 6: return oc_products(std::integral_constant<std::size_t, 6>{}, s, a0, h, x, a, check);
-        case 7: return oc_products(std::integral_constant<std::size_t, 7>{}, s, a0, h, x, a, check);
-        default: return oc_products(std::integral_constant<std::size_t, 8>{}, s, a0, h, x, a, check);
+        case 2: return oc_products(std::integral_constant<std::size_t, 2>{}, s, a0, h, x, check, done);
+        case 3: return oc_products(std::integral_constant<std::size_t, 3>{}, s, a0, h, x, check, done);
+        case 4: return oc_products(std::integral_constant<std::size_t, 4>{}, s, a0, h, x, check, done);
+        case 5: return oc_products(std::integral_constant<std::size_t, 5>{}, s, a0, h, x, check, done);
+        case 6: return oc_products(std::integral_constant<std::size_t, 6>{}, s, a0, h, x, check, done);
+        case 7: return oc_products(std::integral_constant<std::size_t, 7>{}, s, a0, h, x, check, done);
+        default: return oc_products(std::integral_constant<std::size_t, 8>{}, s, a0, h, x, check, done);
       }
     } else {
-      return oc_products(static_cast<std::size_t>(nprod), s, a0, h, x, a, check);
+      MemberProducts x{xs_, as_};
+      return oc_products(static_cast<std::size_t>(nprod), s, a0, h, x, check, done);
     }
   }
 
@@ -886,15 +919,12 @@ class AdaptiveMpeIntegrator {
     std::vector<adaptive_detail::StepController> ctl(static_cast<std::size_t>(nmax_) + 1,
                                                      adaptive_detail::StepController(opt_));
     // err_n / err_{n-1} of the last full step of n products, and its step (the early rejection's prediction).
-    std::vector<double> ratio(static_cast<std::size_t>(nmax_) + 1, 0.0), ratio_h = ratio;
 
     real_type t = t0, h;
     bool error_finite = true;
     constexpr bool local = fixed_lockstep;
     std::conditional_t<local, State<V>, State<V>&> s = s_io;
     State<V> inc = s_io, err = s_io, inc_lo = s_io, err_lo = s_io;
-    std::array<State<V>, 8> lx;
-    std::array<V, 8> la{};
     if (!local) resize_buffers(s_io);
     if (Comp) comp_.begin(s_io);
     std::conditional_t<local, V, V&> ccq = comp_.cq, ccv = comp_.cv;
@@ -943,44 +973,32 @@ class AdaptiveMpeIntegrator {
       double elo = std::numeric_limits<double>::quiet_NaN();  // the estimate of order j - 1 (below)
       int taken = 0;                                          // the products of the solution taken (0: rejected)
       bool early_reject = false;
-      auto run_products = [&](auto& x, auto& a) {
-        auto check = [&]() -> bool {
-          if (n - 1 < 2) return true;
-          oc_combine(static_cast<std::size_t>(n - 1), x, inc_lo, err_lo);
-          e2_lo = error_norm2(s, inc_lo, err_lo, err_scale, ocnoise_[static_cast<std::size_t>(n - 1)]);
-          if (e2_lo <= 1.0) {
-            taken = n - 1;
-            return false;
-          }
-          const double rho = ratio[static_cast<std::size_t>(n)];
-          if (rho > 0) {
-            const double hr = hd / ratio_h[static_cast<std::size_t>(n)];
-            if (std::sqrt(e2_lo) * rho * hr * hr > 16.0) {
-              early_reject = true;
-              return false;
-            }
-          }
-          return true;
-        };
-        own_evals_ += oc_dispatch(n, s, a0, h, x, a, check);
+      auto check = [&](const auto& x) -> bool {
+        if (n - 1 < 2) return true;
+        oc_combine(static_cast<std::size_t>(n - 1), x, inc_lo, err_lo);
+        e2_lo = error_norm2(s, inc_lo, err_lo, err_scale, ocnoise_[static_cast<std::size_t>(n - 1)]);
+        if (e2_lo <= 1.0) {
+          taken = n - 1;
+          return false;
+        }
+        if (!std::isfinite(e2_lo)) {  // the force returned NaN or inf: product n cannot help
+          early_reject = true;
+          return false;
+        }
+        return true;
+      };
+      auto done = [&](const auto& x) {
         if (taken == 0 && !early_reject) {
           oc_combine(static_cast<std::size_t>(n), x, inc, err);
           e2 = error_norm2(s, inc, err, err_scale, ocnoise_[static_cast<std::size_t>(n)]);
           if (e2 <= 1.0) taken = n;
-          if (std::isfinite(e2) && std::isfinite(e2_lo) && e2_lo > 0) {
-            ratio[static_cast<std::size_t>(n)] = std::sqrt(e2 / e2_lo);
-            ratio_h[static_cast<std::size_t>(n)] = hd;
-          }
           if (n - 1 >= 2) elo = e2_lo;
         } else if (n - 2 >= 2) {  // stopped after products 1..n-1: the estimate of order 2n - 4 as well
           oc_combine(static_cast<std::size_t>(n - 2), x, inc, err);
           elo = error_norm2(s, inc, err, err_scale, ocnoise_[static_cast<std::size_t>(n - 2)]);
         }
       };
-      if constexpr (local)
-        run_products(lx, la);
-      else
-        run_products(xs_, as_);
+      own_evals_ += oc_dispatch(n, s, a0, h, check, done);
       // j: the highest order estimated (the one taken, or the last one computed); elo that of j - 1.
       const int j = (taken == n - 1 || early_reject) ? n - 1 : n;
       const double ej = j == n ? e2 : e2_lo;
@@ -1012,10 +1030,10 @@ class AdaptiveMpeIntegrator {
         if (j - 1 >= 2) {
           const double fl = ctl[static_cast<std::size_t>(j - 1)].accepted(qof(elo, j - 1), hd, after_rej);
           const double wj = work_[static_cast<std::size_t>(j)] / fj, wl = work_[static_cast<std::size_t>(j - 1)] / fl;
-          if (wl < 0.8 * wj) {
+          if (wl < 0.7 * wj) {
             next = j - 1;
             fac = fl;
-          } else if (j < nmax_ && !after_rej && wj < 0.9 * wl) {
+          } else if (j < nmax_ && !after_rej && wj < 1.0 * wl) {
             next = j + 1;
             fac = std::min(opt_.fac_max,
                            fj * work_[static_cast<std::size_t>(j + 1)] / work_[static_cast<std::size_t>(j)]);
@@ -1037,7 +1055,7 @@ class AdaptiveMpeIntegrator {
         int next = j;
         if (j - 1 >= 2 && std::isfinite(elo)) {
           const double fl = ctl[static_cast<std::size_t>(j - 1)].rejected(qof(elo, j - 1));
-          if (work_[static_cast<std::size_t>(j - 1)] / fl < 0.8 * work_[static_cast<std::size_t>(j)] / fj) {
+          if (work_[static_cast<std::size_t>(j - 1)] / fl < 0.7 * work_[static_cast<std::size_t>(j)] / fj) {
             next = j - 1;
             fac = fl;
           }
