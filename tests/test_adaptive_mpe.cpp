@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -272,4 +273,143 @@ TEST(AdaptiveMpe, BadInputThrows) {
   State<V2> radial{{1.0, 0.0}, {0.0, 0.0}};
   auto tight = make_adaptive_mpe_integrator<V2>(def, CountingKepler{&calls}, with_tol(1e-12));
   EXPECT_THROW(tight.integrate_to(radial, 0.0, 2.0), StepSizeUnderflow);
+}
+
+// ---- order control (MPE-adaptive) ---------------------------------------------------------------------
+
+namespace {
+
+struct OrderRun {
+  State<V2> s;
+  AdaptiveStats st;
+  std::vector<long> hist;
+  long calls = 0, early = 0;
+  double error = 0;
+};
+
+OrderRun order_run(const char* spec, double ecc, double tol, double t1) {
+  OrderRun r;
+  auto ai = make_adaptive_mpe_integrator<V2>(resolve_method(spec), CountingKepler{&r.calls}, with_tol(tol));
+  r.s = KeplerProblem<double>(ecc).initial_state();
+  r.st = ai.integrate_to(r.s, 0.0, t1);
+  r.hist = ai.order_histogram();
+  r.early = ai.early_rejections();
+  r.error = position_error(r.s, ecc, t1);
+  return r;
+}
+
+// The mean order of the accepted steps.
+double mean_order(const std::vector<long>& hist) {
+  double n = 0, sum = 0;
+  for (std::size_t p = 0; p < hist.size(); ++p) {
+    n += static_cast<double>(hist[p]);
+    sum += static_cast<double>(p * static_cast<std::size_t>(hist[p]));
+  }
+  return n > 0 ? sum / n : 0;
+}
+
+}  // namespace
+
+// The catalog entry and its order cap: the metadata of the largest step (k = 1..8: 36 forces, order 16).
+TEST(AdaptiveMpeOrderControl, CatalogEntry) {
+  const MethodDef def = resolve_method("MPE-adaptive");
+  EXPECT_TRUE(def.info.adaptive);
+  EXPECT_EQ(def.info.family, "mpe");
+  EXPECT_EQ(def.info.order, 16);
+  EXPECT_EQ(def.info.stages, 36);
+  EXPECT_EQ(def.info.forces_per_step, 36);
+  EXPECT_FALSE(def.info.source.empty());
+  const MethodDef capped = resolve_method("mpe-adaptive-max:10");
+  EXPECT_EQ(capped.info.order, 10);
+  EXPECT_EQ(capped.info.forces_per_step, 15);
+  long calls = 0;
+  auto ai = make_adaptive_mpe_integrator<V2>(capped, CountingKepler{&calls}, with_tol(1e-9));
+  EXPECT_EQ(ai.max_products(), 5);
+  EXPECT_EQ(ai.order_histogram().size(), 11u);
+  for (const char* spec : {"MPE-adaptive-max:", "MPE-adaptive-max:2", "MPE-adaptive-max:7", "MPE-adaptive-max:18",
+                           "MPE-adaptive-max:100", "MPE-adaptive-max:x", "MPE-adaptive-max:-4", "MPE-adaptive-max:1e1"})
+    EXPECT_THROW(resolve_method(spec), std::invalid_argument) << spec;
+}
+
+// Work per unit step: a loose tolerance makes the low orders' steps nearly as long as the high orders', so
+// they win; a tight one favours the high orders (their step shrinks like tol^(1/(2n-1))). Kepler e = 0.5,
+// one period: the mean order of the accepted steps rises with the tolerance's digits, the histogram counts
+// every accepted step, and the error falls with the tolerance.
+TEST(AdaptiveMpeOrderControl, OrderRisesAsTheToleranceTightens) {
+  const double T = KeplerProblem<double>::period();
+  std::vector<double> means, errors;
+  for (double tol : {1e-5, 1e-9, 1e-12}) {
+    const OrderRun r = order_run("MPE-adaptive", 0.5, tol, T);
+    long sum = 0;
+    for (long c : r.hist) sum += c;
+    EXPECT_EQ(sum, r.st.accepted) << tol;
+    EXPECT_EQ(r.hist[0] + r.hist[2], 0) << tol;  // the smallest order is 4 (two products)
+    EXPECT_LT(r.error, 10 * tol) << tol;         // a global error from local errors below tol over ~20 steps
+    means.push_back(mean_order(r.hist));
+    errors.push_back(r.error);
+    std::cout << "[ orders   ] tol " << tol << ": mean order " << means.back() << ", error " << r.error << ", "
+              << r.st.accepted << " steps, " << r.st.rejected << " rejected (" << r.early << " early)" << std::endl;
+  }
+  EXPECT_LT(means[0], 10);
+  EXPECT_GT(means[2], 13);
+  EXPECT_GT(means[1], means[0] + 2);
+  EXPECT_GE(means[2], means[1]);
+  EXPECT_LT(errors[1], errors[0] * 1e-2);
+  EXPECT_LT(errors[2], errors[1] * 1e-2);
+}
+
+// Exact force counting with steps of several orders, steps stopped early after products 1..n-1 and rejected
+// ones: the engine's count is the force's, over several calls that continue the run.
+TEST(AdaptiveMpeOrderControl, CountsForcesExactly) {
+  long calls = 0;
+  auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("MPE-adaptive"), CountingKepler{&calls}, with_tol(1e-10));
+  State<V2> s = KeplerProblem<double>(0.9).initial_state();
+  const double T = KeplerProblem<double>::period();
+  long sum = 0;
+  for (int i = 0; i < 4; ++i) sum += ai.integrate_to(s, T * i / 2, T * (i + 1) / 2).force_evals;
+  EXPECT_EQ(sum, calls);
+  EXPECT_EQ(ai.force_evals(), calls);
+  EXPECT_EQ(ai.total().force_evals, calls);
+  EXPECT_GT(ai.total().rejected, 0);  // e = 0.9: the pericentre rejects steps
+  int orders = 0;
+  for (long c : ai.order_histogram()) orders += c > 0;
+  EXPECT_GE(orders, 2);
+  EXPECT_LT(position_error(s, 0.9, 2 * T), 1e-7);
+}
+
+// With orders up to 4 only (two products, nothing to choose), the controller is the fixed-order one:
+// MPE-adaptive-max:4 is bitwise M4-adaptive, force counts included.
+TEST(AdaptiveMpeOrderControl, PinnedOrderIsTheFixedOrderEngine) {
+  const double T = KeplerProblem<double>::period();
+  const OrderRun a = order_run("MPE-adaptive-max:4", 0.9, 1e-7, T);
+  long calls = 0;
+  auto fixed = make_adaptive_mpe_integrator<V2>(resolve_method("M4-adaptive"), CountingKepler{&calls}, with_tol(1e-7));
+  State<V2> s = KeplerProblem<double>(0.9).initial_state();
+  const AdaptiveStats st = fixed.integrate_to(s, 0.0, T);
+  EXPECT_EQ(a.st.accepted, st.accepted);
+  EXPECT_EQ(a.st.rejected, st.rejected);
+  EXPECT_EQ(a.st.force_evals, st.force_evals);
+  EXPECT_EQ(a.hist[4], st.accepted);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(a.s.q[i], s.q[i]);
+    EXPECT_EQ(a.s.v[i], s.v[i]);
+  }
+}
+
+// The unrolled path (std::array of double) and the run-time one (std::vector; long double arrays) take the
+// same steps: bitwise the same trajectory, orders and force counts.
+TEST(AdaptiveMpeOrderControl, StateTypesAgree) {
+  const MethodDef def = resolve_method("MPE-adaptive");
+  const OrderRun a = order_run("MPE-adaptive", 0.9, 1e-9, 7.0);
+  long calls = 0;
+  auto ai = make_adaptive_mpe_integrator<VD>(def, CountingKepler{&calls}, with_tol(1e-9));
+  const auto s0 = KeplerProblem<double>(0.9).initial_state();
+  State<VD> s{{s0.q[0], s0.q[1]}, {s0.v[0], s0.v[1]}};
+  const AdaptiveStats st = ai.integrate_to(s, 0.0, 7.0);
+  EXPECT_EQ(st.force_evals, a.st.force_evals);
+  EXPECT_EQ(ai.order_histogram(), a.hist);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(s.q[i], a.s.q[i]);
+    EXPECT_EQ(s.v[i], a.s.v[i]);
+  }
 }

@@ -88,9 +88,9 @@ const std::vector<std::string> kNystromFixed{"VV",  "M4",  "M6",   "M6-5F", "A6"
                                              "KL8", "M10", "SS10", "M12",   "DP12"};
 const std::vector<std::string> kOdeintFixed{"odeint velocity_verlet", "odeint sb3a_mclachlan",
                                             "odeint sb3a_m4_mclachlan", "odeint rkf78"};
-const std::vector<std::string> kAdaptive{"DP12-adaptive", "M10-adaptive",  "M12-adaptive",
-                                         "M14-adaptive",  "M16-adaptive",  "M12-adaptive (no comp.)",
-                                         "GBS",           "odeint dopri5", "odeint bulirsch_stoer"};
+const std::vector<std::string> kAdaptive{
+    "DP12-adaptive",           "M10-adaptive", "M12-adaptive",  "M14-adaptive",         "M16-adaptive", "MPE-adaptive",
+    "M12-adaptive (no comp.)", "GBS",          "odeint dopri5", "odeint bulirsch_stoer"};
 
 // The orders the publications give the fixed-step methods (not read from the tool's JSON): Chin (2010)
 // for the multi-product M<2n> (order 2n), M6-5F and Albrecht's A6; Kahan-Li KL8, Sofroniou-Spaletta SS10,

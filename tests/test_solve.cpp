@@ -47,6 +47,7 @@ TEST(Solve, EveryFamilyReachesTheAnalyticKeplerOrbit) {
       {"A6", {.h = 0.003}, 1e-9},
       {"DP12-adaptive", {.rtol = 1e-12}, 1e-9},
       {"M12-adaptive", {.rtol = 1e-12}, 1e-9},
+      {"MPE-adaptive", {.rtol = 1e-12}, 1e-9},
       {"GBS", {.rtol = 1e-12}, 1e-9},
       {"Chambers", {.steps = 20000}, 1e-6},
   };

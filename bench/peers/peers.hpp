@@ -404,7 +404,7 @@ inline std::vector<MethodSpec> peer_methods(double ecc, long periods) {
   for (const char* name : {"VV", "M4", "M6", "M6-5F", "A6", "M8", "KL8", "M10", "SS10", "M12", "DP12"})
     m.push_back(nystrom_fixed(name, ecc, periods));
   m.push_back(nystrom_adaptive("DP12-adaptive", ecc, periods));
-  for (const char* name : {"M10-adaptive", "M12-adaptive", "M14-adaptive", "M16-adaptive"})
+  for (const char* name : {"M10-adaptive", "M12-adaptive", "M14-adaptive", "M16-adaptive", "MPE-adaptive"})
     m.push_back(nystrom_adaptive_mpe(name, ecc, periods));
   m.push_back(nystrom_adaptive_mpe("M12-adaptive", ecc, periods, Compensation::off));
   m.push_back(nystrom_gbs(ecc, periods));

@@ -1,5 +1,6 @@
 // Step-size control for the multi-product expansion (catalog specs "M10-adaptive",
-// "mpe-adaptive:1,2,3,4,5", "mpe-vv-adaptive:1,2,3").
+// "mpe-adaptive:1,2,3,4,5", "mpe-vv-adaptive:1,2,3"), and order and step control over the natural sequence
+// ("MPE-adaptive", orders 4..16; "MPE-adaptive-max:P", orders 4..P: see "order control" below, run_oc).
 //
 // The MPE T_2n(h) = sum_i c_i T_2^{k_i}(h / k_i) (Chin eq 14; engines/mpe.hpp) is Richardson
 // extrapolation in h^2 of a symmetric second-order base. Dropping the product of largest k leaves
@@ -100,6 +101,14 @@ inline AdaptiveMpeCoefficients adaptive_mpe_coefficients(const std::vector<long>
   return r;
 }
 
+/// The coefficients of order control (AdaptiveMpeIntegrator): for each number of products n = 2..N of the
+/// natural sequence k = 1..N, c[n] those of T_2n over k = 1..n and d[n] those of T_2n - T_{2n-2}; entries 0
+/// and 1 empty.
+template <class S>
+struct MpeOrderTables {
+  std::vector<std::vector<S>> c, d;
+};
+
 template <class V, class Force>
 class AdaptiveMpeIntegrator {
   static std::string sci(double x) { return adaptive_detail::sci(x); }
@@ -112,9 +121,11 @@ class AdaptiveMpeIntegrator {
 
   /// k: the sequence (>= 2 members); c: its coefficients (order 2n) and d = c - chat (the error
   /// combination), in the working type; base: the symmetric second-order T_2.
+  /// orders: empty for one order per run; else order control over the prefixes of the natural sequence k =
+  /// 1..N (see MpeOrderTables).
   AdaptiveMpeIntegrator(std::vector<long> k, std::vector<scalar_type> c, std::vector<scalar_type> d,
                         SplittingScheme<scalar_type> base, Force force, AdaptiveOptions opt = {},
-                        EngineOptions eopt = {})
+                        EngineOptions eopt = {}, MpeOrderTables<scalar_type> orders = {})
       : opt_(opt),
         eopt_(eopt),
         k_(std::move(k)),
@@ -158,6 +169,7 @@ class AdaptiveMpeIntegrator {
     by_k_.resize(k_.size());
     for (std::size_t r = 0; r < k_.size(); ++r) by_k_[r] = r;
     std::sort(by_k_.begin(), by_k_.end(), [this](std::size_t x, std::size_t y) { return k_[x] > k_[y]; });
+    if (!orders.c.empty()) setup_order_control(std::move(orders));
   }
 
   const AdaptiveOptions& options() const { return opt_; }
@@ -167,6 +179,14 @@ class AdaptiveMpeIntegrator {
   bool compensated() const { return compensated_; }
   const std::vector<long>& sequence() const { return k_; }
   const AdaptiveStats& total() const { return total_; }
+  /// Order control: the largest number of products per step (0: one order per run).
+  int max_products() const { return nmax_; }
+  /// Order control: the accepted steps of all calls so far by the order of the solution they propagated
+  /// (index: the order 2n; size 2N + 1). Empty for one order per run.
+  const std::vector<long>& order_histogram() const { return hist_; }
+  /// Order control: steps rejected after the products of order 2n - 2 alone, before the last pair of the
+  /// longest product (their estimate was not finite: the force returned NaN or inf).
+  long early_rejections() const { return early_rejected_; }
   Force& force() { return base_.force(); }
   /// Force evaluations of all calls so far (the starting-step estimates included).
   long force_evals() const { return base_.force_evals() + extra_evals_ + own_evals_; }
@@ -201,6 +221,7 @@ class AdaptiveMpeIntegrator {
   /// Forget the step carried over between calls (the next call estimates a first step again).
   void reset() {
     h_next_ = real_type(0);
+    n_next_ = 0;
     comp_.invalidate();
     resume_.valid = false;
   }
@@ -217,6 +238,7 @@ class AdaptiveMpeIntegrator {
 
   template <bool Comp, class Observer>
   AdaptiveStats dispatch(State<V>& s, real_type t0, real_type t1, Observer& obs) {
+    if (nmax_ > 0) return run_oc<Comp>(s, t0, t1, obs);
     if constexpr (fixed_lockstep) {
       if (lockstep_) {
         switch (k_.size()) {
@@ -658,6 +680,395 @@ class AdaptiveMpeIntegrator {
     return st;
   }
 
+  // ---- order control ------------------------------------------------------------------------------------
+  //
+  // The natural sequence k = 1..N on a Verlet base (HNW I, sec. II.9, ODEX, carried over from the GBS columns to
+  // the products): a step of target n runs the products k = 1..n in lockstep, the longest first in every
+  // sub-step, so that products 1..n-1 are complete one pair before product n. Then the convergence monitor:
+  //   * err_{n-1}, the estimate of T_{2n-2} - T_{2n-4} (products 1..n-1, free), <= 1: the step is accepted with
+  //     T_{2n-2}, without the last force(s) of product n;
+  //   * err_{n-1} not finite (the force returned NaN or inf): the step is rejected at once;
+  //   * else product n completes, and the step is accepted with T_2n when err_n <= 1.
+  // Then order and step: H_j = h * ratio_j (the step ratio of order j by the controller of the fixed-order
+  // engine, adaptive_detail::StepController, one per order, Gustafsson's predictive ratio included) for the
+  // order j of the solution taken and j - 1, the work per unit step W_j = A_j / H_j, and the next target is
+  // j - 1 when W_{j-1} < 0.7 W_j, else j + 1 with step H_j A_{j+1} / A_j when W_j < W_{j-1} and the step was
+  // accepted (HNW I, eqs (9.25)-(9.28) with the orders of the products in place of the columns), else j.
+  // A_n = n + 3: the time of a lockstep step of n products is set by its chain of n forces, not by its
+  // n(n+1)/2 forces (measured on Kepler e = 0.9, fixed-order steps of 4..8 products: about (n + 2.7) x 26 ns);
+  // with A_n = n(n+1)/2, as ODEX counts, the controller chose orders 8-12 where M14/M16 are faster. The factors
+  // 0.7 and 1.0 instead of ODEX's 0.8 and 0.9: fewer order changes (tol 1e-9, e = 0.9: 0.99 ms with 0.8 and 0.9,
+  // 0.82 ms with 0.7 and 1.0, at a final error of 7e-6 and 1.2e-5).
+  // ODEX's early rejection of a hopeless step (err_n predicted from err_{n-1} and the last ratio err_n /
+  // err_{n-1}) rejected steps that would have passed: at tol 1e-12, e = 0.9, rejections 201 -> 529 and 18%
+  // more time; it saves one pair of one product, so it is left out. A target of two products has no lower
+  // estimate; it moves up when its step ratio is at fac_max. The error scale, its noise floor (per n), the exact ends,
+  // the compensated increments and the force counts are those of the fixed-order engine.
+
+  void setup_order_control(MpeOrderTables<scalar_type> orders) {
+    const std::size_t N = k_.size();
+    if (N > 8) throw std::invalid_argument("adaptive MPE order control: at most 8 products (order 16)");
+    for (std::size_t i = 0; i < N; ++i)
+      if (k_[i] != static_cast<long>(i) + 1)
+        throw std::invalid_argument("adaptive MPE order control runs the natural sequence 1, 2, ..., N only");
+    if (!merged_ || m_ != 3)
+      throw std::invalid_argument("adaptive MPE order control needs a Verlet base (three merged sub-steps)");
+    if (orders.c.size() != N + 1 || orders.d.size() != N + 1)
+      throw std::invalid_argument("adaptive MPE order control: one coefficient table per product count is needed");
+    for (std::size_t n = 2; n <= N; ++n) {
+      if (orders.c[n].size() != n || orders.d[n].size() != n)
+        throw std::invalid_argument("adaptive MPE order control: a table has the wrong length");
+      for (std::size_t i = 0; i < n; ++i)
+        if (!is_finite_scalar(orders.c[n][i]) || !is_finite_scalar(orders.d[n][i]))
+          throw std::invalid_argument("adaptive MPE: coefficient is not finite");
+    }
+    nmax_ = static_cast<int>(N);
+    occ_ = std::move(orders.c);
+    ocd_ = std::move(orders.d);
+    ocnoise_.assign(N + 1, real_type(0));
+    work_.assign(N + 2, 0.0);
+    hist_.assign(2 * N + 1, 0);
+    for (std::size_t n = 2; n <= N; ++n) {
+      double dsum = 0;
+      for (const auto& di : ocd_[n]) dsum += std::abs(as_double(di));
+      ocnoise_[static_cast<std::size_t>(n)] = real_type(10 * dsum * as_double(epsilon_of<real_type>()));
+    }
+    for (std::size_t n = 1; n <= N + 1; ++n) work_[n] = static_cast<double>(n) + 3;
+  }
+
+  // The increments and forces of the products of one step: local arrays for fixed-size states (nothing of the
+  // step in memory that the force functor could alias, as in trial_verlet: the unrolled step keeps them in
+  // registers; measured on Kepler e = 0.9, the products in std::array<State<V>, 8> made a step twice as slow)
+  // or the member buffers.
+  struct LocalProducts {
+    static constexpr std::size_t D = fixed_lockstep ? std::tuple_size<V>::value : 1;
+    scalar_type dq[8][D], dv[8][D], a[8][D];
+    scalar_type& q(std::size_t r, std::size_t j) { return dq[r][j]; }
+    scalar_type& v(std::size_t r, std::size_t j) { return dv[r][j]; }
+    scalar_type& acc(std::size_t r, std::size_t j) { return a[r][j]; }
+    const scalar_type& q(std::size_t r, std::size_t j) const { return dq[r][j]; }
+    const scalar_type& v(std::size_t r, std::size_t j) const { return dv[r][j]; }
+  };
+  struct MemberProducts {
+    std::vector<State<V>>& x;
+    std::vector<V>& as;
+    scalar_type& q(std::size_t r, std::size_t j) { return x[r].q[j]; }
+    scalar_type& v(std::size_t r, std::size_t j) { return x[r].v[j]; }
+    scalar_type& acc(std::size_t r, std::size_t j) { return as[r][j]; }
+    const scalar_type& q(std::size_t r, std::size_t j) const { return x[r].q[j]; }
+    const scalar_type& v(std::size_t r, std::size_t j) const { return x[r].v[j]; }
+  };
+
+  // The products k = 1..N of a step from s in increment form (product r: k = r + 1), products 1..N-1 complete
+  // before the last pair of product N; then check(x) (true: go on), and after product N done(x). The same
+  // operations per product as trial_verlet (bitwise the same increments). Returns the forces evaluated.
+  template <class Count, class XS, class Check, class Done>
+  NYSTROM_ALWAYS_INLINE long oc_products(Count N, const State<V>& s, const V& a0, const real_type& h, XS& x,
+                                         Check&& check, Done&& done) {
+    const std::size_t n = s.q.size();
+    const auto& st = base_.scheme().steps;
+    const scalar_type b0 = st[0].coef, b1 = st[1].coef, b2 = st[2].coef;
+    const bool kick_first = kick_first_;
+    constexpr bool local = std::is_same_v<XS, LocalProducts>;
+    std::conditional_t<local, V, V&> qt = qbuf_;
+    resize_like(qt, s.q);
+    scalar_type c0[8], c1[8], c2[8], cm[8];
+    for (std::size_t r = 0; r < N; ++r) {
+      const scalar_type hk = h / static_cast<scalar_type>(static_cast<long>(r) + 1);
+      c0[r] = b0 * hk;
+      c1[r] = b1 * hk;
+      c2[r] = b2 * hk;
+      cm[r] = c2[r] + c0[r];
+      for (std::size_t j = 0; j < n; ++j) {
+        x.q(r, j) = scalar_type(0);
+        x.v(r, j) = scalar_type(0);
+        x.acc(r, j) = kick_first ? a0[j] : scalar_type(0);
+      }
+    }
+    long evals = 0;
+    auto force = [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
+      if constexpr (local) {
+        V q, ar;  // fresh locals per call: no false dependence between the products' chains
+        for (std::size_t j = 0; j < n; ++j) q[j] = s.q[j] + x.q(r, j);
+        base_.force()(q, ar);
+        for (std::size_t j = 0; j < n; ++j) x.acc(r, j) = ar[j];
+      } else {
+        for (std::size_t j = 0; j < n; ++j) qt[j] = s.q[j] + x.q(r, j);
+        base_.force()(qt, x.as[r]);
+      }
+      ++evals;
+    };
+    auto drift = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
+      for (std::size_t j = 0; j < n; ++j) x.q(r, j) += c * (s.v[j] + x.v(r, j));
+    };
+    auto kick = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
+      for (std::size_t j = 0; j < n; ++j) x.v(r, j) += c * x.acc(r, j);
+    };
+    auto pair = [&](std::size_t r, std::size_t p) NYSTROM_ALWAYS_INLINE {
+      if (kick_first) {
+        if (p > 0) force(r);
+        kick(r, p == 0 ? c0[r] : cm[r]);
+        drift(r, c1[r]);
+      } else {
+        drift(r, p == 0 ? c0[r] : cm[r]);
+        force(r);
+        kick(r, c1[r]);
+      }
+    };
+    auto finish = [&](std::size_t r) NYSTROM_ALWAYS_INLINE {
+      if (kick_first) {
+        force(r);
+        kick(r, c2[r]);
+      } else {
+        drift(r, c2[r]);
+      }
+    };
+    const std::size_t top = N - 1;
+    for (std::size_t p = 0; p < top; ++p) {
+      for (std::size_t r = top + 1; r-- > p;) pair(r, p);  // the products with k > p, the longest first
+      finish(p);                                           // product k = p + 1 has made its k pairs
+    }
+    if (check(static_cast<const XS&>(x))) {
+      pair(top, top);
+      finish(top);
+    }
+    done(static_cast<const XS&>(x));
+    return evals;
+  }
+
+  // inc = T_2n - s and err = T_2n - T_{2n-2} from the increments of products 1..n, as in trial_verlet.
+  template <class XS>
+  NYSTROM_ALWAYS_INLINE void oc_combine(std::size_t nprod, const XS& x, State<V>& inc, State<V>& err) const {
+    const std::size_t n = inc.q.size();
+    const std::size_t ref = nprod - 1;
+    const scalar_type* c = occ_[nprod].data();
+    const scalar_type* d = ocd_[nprod].data();
+    for (std::size_t j = 0; j < n; ++j) {
+      inc.q[j] = scalar_type(0);
+      inc.v[j] = scalar_type(0);
+      err.q[j] = scalar_type(0);
+      err.v[j] = scalar_type(0);
+    }
+    for (std::size_t i = 0; i < ref; ++i) {
+      const scalar_type ci = c[i], di = d[i];
+      for (std::size_t j = 0; j < n; ++j) {
+        const scalar_type eq = x.q(i, j) - x.q(ref, j), ev = x.v(i, j) - x.v(ref, j);
+        inc.q[j] += ci * eq;
+        inc.v[j] += ci * ev;
+        err.q[j] += di * eq;
+        err.v[j] += di * ev;
+      }
+    }
+    for (std::size_t j = 0; j < n; ++j) {
+      inc.q[j] += x.q(ref, j);
+      inc.v[j] += x.v(ref, j);
+    }
+  }
+
+  // The first target: ODEX's rule (HNW I, sec. II.9) for the orders of the products.
+  // The smallest target: three products (the step can still stop at two), so that every full step has the
+  // estimates of two orders to choose from; two when that is the largest.
+  int nmin_target() const { return std::min(3, nmax_); }
+
+  int oc_initial_products() const {
+    const double tol = opt_.tol > 0 ? opt_.tol : opt_.atol;
+    const int n = static_cast<int>(-0.6 * std::log10(tol) + 1.5);
+    return std::max(nmin_target(), std::min(nmax_, n));
+  }
+
+  // The products of one step, unrolled for fixed-size states (see LocalProducts).
+  template <class Check, class Done>
+  NYSTROM_ALWAYS_INLINE long oc_dispatch(int nprod, const State<V>& s, const V& a0, const real_type& h, Check&& check,
+                                         Done&& done) {
+    if constexpr (fixed_lockstep) {
+      LocalProducts x;
+      switch (nprod) {
+        case 2: return oc_products(std::integral_constant<std::size_t, 2>{}, s, a0, h, x, check, done);
+        case 3: return oc_products(std::integral_constant<std::size_t, 3>{}, s, a0, h, x, check, done);
+        case 4: return oc_products(std::integral_constant<std::size_t, 4>{}, s, a0, h, x, check, done);
+        case 5: return oc_products(std::integral_constant<std::size_t, 5>{}, s, a0, h, x, check, done);
+        case 6: return oc_products(std::integral_constant<std::size_t, 6>{}, s, a0, h, x, check, done);
+        case 7: return oc_products(std::integral_constant<std::size_t, 7>{}, s, a0, h, x, check, done);
+        default: return oc_products(std::integral_constant<std::size_t, 8>{}, s, a0, h, x, check, done);
+      }
+    } else {
+      MemberProducts x{xs_, as_};
+      return oc_products(static_cast<std::size_t>(nprod), s, a0, h, x, check, done);
+    }
+  }
+
+  template <bool Comp, class Observer>
+  AdaptiveStats run_oc(State<V>& s_io, real_type t0, real_type t1, Observer& obs) {
+    AdaptiveStats st;
+    const long evals_before = force_evals();
+    obs(static_cast<const real_type&>(t0), static_cast<const State<V>&>(s_io));
+    if (t1 == t0) return st;
+
+    const adaptive_detail::ErrorScale<real_type> err_scale(opt_);
+    int nt = n_next_ > 0 ? n_next_ : oc_initial_products();  // the target number of products
+    adaptive_detail::StepSequence<real_type> seq(opt_, resume_, h_next_, t0, t1, [&](const real_type& hmax) {
+      long calls = 0;
+      auto counted = [&](const V& q, V& a) {
+        ++calls;
+        base_.force()(q, a);
+      };
+      const real_type h = adaptive_detail::hairer_initial_step<V>(counted, s_io, hmax, err_scale, 2 * nt);
+      extra_evals_ += calls;
+      return h;
+    });
+    std::vector<adaptive_detail::StepController> ctl(static_cast<std::size_t>(nmax_) + 1,
+                                                     adaptive_detail::StepController(opt_));
+    // err_n / err_{n-1} of the last full step of n products, and its step (the early rejection's prediction).
+
+    real_type t = t0, h;
+    bool error_finite = true;
+    constexpr bool local = fixed_lockstep;
+    std::conditional_t<local, State<V>, State<V>&> s = s_io;
+    State<V> inc = s_io, err = s_io, inc_lo = s_io, err_lo = s_io;
+    if (!local) resize_buffers(s_io);
+    if (Comp) comp_.begin(s_io);
+    std::conditional_t<local, V, V&> ccq = comp_.cq, ccv = comp_.cv;
+    std::conditional_t<local, V, V&> a0 = a0_;
+    resize_like(a0, s_io.q);
+    bool a0_valid = false;
+    long a0_evals = 0;
+    long accepted = 0, rejected = 0;
+    double last_h = 0;
+    auto store = [&] {
+      if (&s != &s_io) s_io = s;
+      if (&ccq != &comp_.cq) {
+        comp_.cq = ccq;
+        comp_.cv = ccv;
+      }
+      if (Comp) comp_.end(s_io);
+      extra_evals_ += a0_evals;
+      a0_evals = 0;
+      st.accepted = accepted;
+      st.rejected = rejected;
+      st.last_h = last_h;
+      st.force_evals = force_evals() - evals_before;
+      n_next_ = nt;
+    };
+    // q_j = err_j^(-1/(2j - 1)) from the squared norm (the estimate of order 2j is O(h^(2j-1))).
+    auto qof = [](double e2, int j) { return std::pow(e2, -0.5 / (2 * j - 1)); };
+
+    while (t < t1) {
+      if (accepted + rejected >= opt_.max_steps) {
+        store();
+        adaptive_detail::throw_too_many_steps("adaptive MPE", opt_.max_steps, as_double(t), as_double(t1));
+      }
+      bool last;
+      if (!seq.template next<true>(t, h, last)) {
+        store();
+        adaptive_detail::throw_underflow("adaptive MPE", as_double(t), as_double(h), error_finite);
+      }
+      if (kick_first_ && !a0_valid) {
+        base_.force()(s.q, a0);
+        ++a0_evals;
+        a0_valid = true;
+      }
+      const int n = nt;
+      const double hd = as_double(h);
+      double e2_lo = std::numeric_limits<double>::infinity(), e2 = e2_lo;
+      double elo = std::numeric_limits<double>::quiet_NaN();  // the estimate of order j - 1 (below)
+      int taken = 0;                                          // the products of the solution taken (0: rejected)
+      bool early_reject = false;
+      auto check = [&](const auto& x) -> bool {
+        if (n - 1 < 2) return true;
+        oc_combine(static_cast<std::size_t>(n - 1), x, inc_lo, err_lo);
+        e2_lo = error_norm2(s, inc_lo, err_lo, err_scale, ocnoise_[static_cast<std::size_t>(n - 1)]);
+        if (e2_lo <= 1.0) {
+          taken = n - 1;
+          return false;
+        }
+        if (!std::isfinite(e2_lo)) {  // the force returned NaN or inf: product n cannot help
+          early_reject = true;
+          return false;
+        }
+        return true;
+      };
+      auto done = [&](const auto& x) {
+        if (taken == 0 && !early_reject) {
+          oc_combine(static_cast<std::size_t>(n), x, inc, err);
+          e2 = error_norm2(s, inc, err, err_scale, ocnoise_[static_cast<std::size_t>(n)]);
+          if (e2 <= 1.0) taken = n;
+          if (n - 1 >= 2) elo = e2_lo;
+        } else if (n - 2 >= 2) {  // stopped after products 1..n-1: the estimate of order 2n - 4 as well
+          oc_combine(static_cast<std::size_t>(n - 2), x, inc, err);
+          elo = error_norm2(s, inc, err, err_scale, ocnoise_[static_cast<std::size_t>(n - 2)]);
+        }
+      };
+      own_evals_ += oc_dispatch(n, s, a0, h, check, done);
+      // j: the highest order estimated (the one taken, or the last one computed); elo that of j - 1.
+      const int j = (taken == n - 1 || early_reject) ? n - 1 : n;
+      const double ej = j == n ? e2 : e2_lo;
+      error_finite = std::isfinite(ej);
+      const State<V>& inc_taken = taken == n ? inc : inc_lo;
+      if (taken) {
+        for (std::size_t i = 0; i < s.q.size(); ++i) {
+          if constexpr (Comp) {
+            compensated_add(s.q[i], ccq[i], inc_taken.q[i]);
+            compensated_add(s.v[i], ccv[i], inc_taken.v[i]);
+          } else {
+            s.q[i] += inc_taken.q[i];
+            s.v[i] += inc_taken.v[i];
+          }
+        }
+        a0_valid = false;
+        t = last ? t1 : t + h;
+        ++accepted;
+        ++hist_[static_cast<std::size_t>(2 * taken)];
+        last_h = hd;
+        const bool stop =
+            adaptive_detail::observe(obs, static_cast<const real_type&>(t), static_cast<const State<V>&>(s));
+        const bool after_rej = seq.after_rejection();
+        for (int i = 2; i <= nmax_; ++i)
+          if (i != j && i != j - 1) ctl[static_cast<std::size_t>(i)].restore(0, 0);
+        const double fj = ctl[static_cast<std::size_t>(j)].accepted(qof(ej, j), hd, after_rej);
+        double fac = fj;
+        int next = j;
+        if (j - 1 >= 2) {
+          const double fl = ctl[static_cast<std::size_t>(j - 1)].accepted(qof(elo, j - 1), hd, after_rej);
+          const double wj = work_[static_cast<std::size_t>(j)] / fj, wl = work_[static_cast<std::size_t>(j - 1)] / fl;
+          if (wl < 0.7 * wj) {
+            next = j - 1;
+            fac = fl;
+          } else if (j < nmax_ && !after_rej && wj < 1.0 * wl) {
+            next = j + 1;
+            fac = std::min(opt_.fac_max,
+                           fj * work_[static_cast<std::size_t>(j + 1)] / work_[static_cast<std::size_t>(j)]);
+          }
+        } else if (j < nmax_ && !after_rej && fj >= opt_.fac_max) {
+          next = j + 1;
+        }
+        nt = std::max(nmin_target(), next);
+        seq.accepted_ratio(fac, h, last, h_next_);
+        if (stop && t < t1) {
+          resume_ = seq.resume_point(t);
+          break;
+        }
+      } else {
+        ++rejected;
+        if (early_reject) ++early_rejected_;
+        const double fj = ctl[static_cast<std::size_t>(j)].rejected(qof(ej, j));
+        double fac = fj;
+        int next = j;
+        if (j - 1 >= 2 && std::isfinite(elo)) {
+          const double fl = ctl[static_cast<std::size_t>(j - 1)].rejected(qof(elo, j - 1));
+          if (work_[static_cast<std::size_t>(j - 1)] / fl < 0.7 * work_[static_cast<std::size_t>(j)] / fj) {
+            next = j - 1;
+            fac = fl;
+          }
+        }
+        nt = std::max(nmin_target(), next);
+        seq.rejected_ratio(fac, h);
+      }
+    }
+    store();
+    total_ += st;
+    return st;
+  }
+
   AdaptiveOptions opt_;
   EngineOptions eopt_;
   std::vector<long> k_;
@@ -680,6 +1091,15 @@ class AdaptiveMpeIntegrator {
   std::vector<V> as_, cqs_, cvs_;
   std::vector<scalar_type> scaled_;
   std::vector<std::size_t> by_k_;  // product indices by decreasing k (trial_verlet's issue order)
+  // Order control (setup_order_control); indexed by the number of products n (0 and 1 unused).
+  int nmax_ = 0;                               // 0: one order per run
+  int n_next_ = 0;                             // the products of the next step (carried between calls)
+  std::vector<std::vector<scalar_type>> occ_;  // the coefficients of T_2n over k = 1..n
+  std::vector<std::vector<scalar_type>> ocd_;  // T_2n - T_{2n-2} over k = 1..n
+  std::vector<real_type> ocnoise_;             // the error scale's floor of each n (see the constructor)
+  std::vector<double> work_;                   // A_n: the cost of a step of n products (in forces)
+  std::vector<long> hist_;                     // accepted steps by order 2n
+  long early_rejected_ = 0;
 };
 
 /// Builds an adaptive MPE for a multi-product method (MpeDef: "M10", "M10-adaptive", "mpe:1,2,3",
@@ -697,8 +1117,24 @@ AdaptiveMpeIntegrator<V, F> make_adaptive_mpe_integrator(const MethodDef& def, F
   MpeCoefficients dm = ac.high;
   dm.c = ac.diff;
   auto conv = [](const bigcomplex& x) { return to_scalar<S>(x); };
+  MpeOrderTables<S> orders;
+  if (m->order_control) {
+    for (std::size_t n = 0; n < m->k.size(); ++n)
+      if (m->k[n] != static_cast<long>(n) + 1)
+        throw std::invalid_argument("adaptive MPE order control runs the natural sequence 1, 2, ..., N only");
+    orders.c.resize(m->k.size() + 1);
+    orders.d.resize(m->k.size() + 1);
+    for (std::size_t n = 2; n <= m->k.size(); ++n) {
+      const AdaptiveMpeCoefficients an =
+          adaptive_mpe_coefficients(std::vector<long>(m->k.begin(), m->k.begin() + static_cast<long>(n)));
+      MpeCoefficients dn = an.high;
+      dn.c = an.diff;
+      orders.c[n] = mpe_coefficients_as<S>(an.high);
+      orders.d[n] = mpe_coefficients_as<S>(dn);
+    }
+  }
   return AdaptiveMpeIntegrator<V, F>(m->k, mpe_coefficients_as<S>(ac.high), mpe_coefficients_as<S>(dm),
-                                     convert_scheme<S>(m->base, conv), std::move(force), opt, eopt);
+                                     convert_scheme<S>(m->base, conv), std::move(force), opt, eopt, std::move(orders));
 }
 
 }  // namespace nystrom

@@ -307,17 +307,23 @@ class StepSequence {
   /// After an accepted step h with ratio q: the next proposal, and into h_carried the step the next
   /// call starts with (a step shortened to land on t1 keeps the earlier proposal).
   void accepted(double q, const R& h, bool last, R& h_carried) {
-    const double fac = ctl_.accepted(q, as_double(h), last_rejected_);
+    accepted_ratio(ctl_.accepted(q, as_double(h), last_rejected_), h, last, h_carried);
+  }
+  /// The same with a step ratio the engine chose itself (order control: the ratio of the next order).
+  void accepted_ratio(double fac, const R& h, bool last, R& h_carried) {
     const R hn = std::min(h * R(fac), hmax_);
     h_carried = last && h < h_want_ ? h_want_ : hn;
     h_want_ = hn;
     last_rejected_ = false;
   }
   /// After a rejected step h with ratio q.
-  void rejected(double q, const R& h) {
-    h_want_ = h * R(ctl_.rejected(q));
+  void rejected(double q, const R& h) { rejected_ratio(ctl_.rejected(q), h); }
+  void rejected_ratio(double fac, const R& h) {
+    h_want_ = h * R(fac);
     last_rejected_ = true;
   }
+  /// The last attempt was rejected (the next accepted step must not grow).
+  bool after_rejection() const { return last_rejected_; }
   /// The point to go on from at t, after an accepted step.
   AdaptiveResumePoint<R> resume_point(const R& t) const {
     return {t, h_want_, hmax_, false, ctl_.q_prev(), ctl_.h_prev(), true};

@@ -7,6 +7,8 @@
 //   mpe-vv:1,2,3          MPE on velocity Verlet
 //   M<2n>-adaptive        natural-sequence MPE with adaptive steps (engines/adaptive_mpe.hpp; needs a tolerance)
 //   mpe-adaptive:1,2,3    adaptive MPE on position Verlet (also mpe-pv-adaptive:), mpe-vv-adaptive: on velocity Verlet
+//   MPE-adaptive          natural-sequence MPE on position Verlet with order (4..16) and step control per step
+//   MPE-adaptive-max:P    the same with orders 4..P (P even, 4 to 16)
 //   adjoint:NAME          the adjoint of a splitting method (sub-steps reversed)
 //   file:PATH             a splitting method from a method file (nystrom/analysis/method_file.hpp, which
 //                         must be included: it installs the reader, set_method_file_reader)

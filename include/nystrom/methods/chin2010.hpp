@@ -8,6 +8,7 @@
 // Tableau rows below are transcribed from the cited equations; the derivation is in the comments.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -172,7 +173,33 @@ inline MethodDef mpe_method(const std::vector<long>& k, const std::string& base,
           }};
 }
 
-/// M4, M6, ..., M16: natural sequences on position Verlet (eq 17).
+/// The natural-sequence MPE on position Verlet with order and step control (engines/adaptive_mpe.hpp): each
+/// step runs the products k = 1..n, n from 2 to max_order / 2 chosen per step by work per unit step, as ODEX
+/// chooses its columns (Hairer, Norsett & Wanner, Solving Ordinary Differential Equations I, 2nd ed., sec. II.9).
+/// Its MethodInfo describes the largest step (order, stages, forces per step).
+inline MethodDef mpe_order_control_method(int max_order, std::string name) {
+  if (max_order < 4 || max_order > 16 || max_order % 2 != 0)
+    throw std::invalid_argument(
+        "the largest order of adaptive MPE order control must be an even number from 4 to "
+        "16, got " +
+        std::to_string(max_order));
+  std::vector<long> k;
+  for (long i = 1; i <= max_order / 2; ++i) k.push_back(i);
+  MethodDef d = mpe_method(k, "PV", std::move(name));
+  d.info.adaptive = true;
+  d.info.source = "Chin (2010) eqs (14), (17); order control after Hairer, Norsett & Wanner, Solving ODEs I, sec. II.9";
+  d.info.description = "multi-product expansion over PV, order 4.." + std::to_string(max_order) +
+                       " and step chosen per step by work per unit step (estimates: the products without the "
+                       "largest k)";
+  d.build = [k] {
+    MpeDef m{k, "PV", position_verlet_scheme()};
+    m.order_control = true;
+    return MethodData{std::move(m)};
+  };
+  return d;
+}
+
+/// M4, M6, ..., M16: natural sequences on position Verlet (eq 17); MPE-adaptive: the same with order control.
 inline std::vector<MethodDef> chin2010_mpe() {
   std::vector<MethodDef> m;
   for (long n = 2; n <= 8; ++n) {
@@ -180,6 +207,7 @@ inline std::vector<MethodDef> chin2010_mpe() {
     for (long i = 1; i <= n; ++i) k.push_back(i);
     m.push_back(mpe_method(k, "PV", "M" + std::to_string(2 * n)));
   }
+  m.push_back(mpe_order_control_method(16, "MPE-adaptive"));
   return m;
 }
 

@@ -33,11 +33,13 @@ struct MethodInfo {
   std::vector<std::string> aliases;
 };
 
-/// A multi-product method: the sequence {k_i} and the symmetric second-order base T_2.
+/// A multi-product method: the sequence {k_i} and the symmetric second-order base T_2. order_control: the
+/// adaptive engine chooses per step how many of the products (a prefix of the natural sequence k) to run.
 struct MpeDef {
   std::vector<long> k;
   std::string base_name;
   SplittingScheme<bigcomplex> base;
+  bool order_control = false;
 };
 
 using MethodData = std::variant<SplittingScheme<bigcomplex>, RknTableau<bigcomplex>, MpeDef>;

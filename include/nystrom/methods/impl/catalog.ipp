@@ -123,6 +123,12 @@ NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
     d.info.description += ", adaptive step (embedded estimate: the products without the largest k)";
     return finalize(d);
   };
+  if (ls.rfind("mpe-adaptive-max:", 0) == 0) {
+    const std::string o = spec.substr(17);
+    if (o.empty() || o.size() > 2 || !std::all_of(o.begin(), o.end(), ::isdigit))
+      throw std::invalid_argument("the largest order of '" + spec + "' must be an even number from 4 to 16");
+    return finalize(methods::mpe_order_control_method(std::stoi(o), "MPE-adaptive-max:" + o));
+  }
   if (ls.rfind("mpe-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(13)), "PV", spec);
   if (ls.rfind("mpe-pv-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(16)), "PV", spec);
   if (ls.rfind("mpe-vv-adaptive:", 0) == 0) return adaptive_mpe(parse_sequence(spec.substr(16)), "VV", spec);
