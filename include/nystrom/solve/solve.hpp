@@ -336,23 +336,27 @@ class Recorder {
   /// j): none with events or dense output (every step end is needed) or without output times (every
   /// step end is saved); else up to the step before the one that reaches the next output time or ends
   /// on a call of on_step. `done`: steps of the run so far; `last`: the last step of the run that may
-  /// be quiet.
+  /// be quiet; `mean_step`: the step size, for a first guess.
   template <class StepEnd>
-  long quiet_steps(long done, long last, StepEnd&& step_end) const {
+  long quiet_steps(long done, long last, StepEnd&& step_end, double mean_step) const {
     if (need_a_ || opt_.t_eval.empty() || last <= done) return 0;
     long end = last;  // the first step end that must be recorded lies after `end`
     if (opt_.on_step) end = std::min(end, done + (opt_.on_step_every - steps_ % opt_.on_step_every) - 1);
     if (next_ < opt_.t_eval.size()) {
-      // The first step end j in (done, last] at or past the next output time, by bisection.
+      // The first step end j in (done, last] at or past the next output time: from the step end nearest
+      // to it by the step size (mean_step: the span of a step, > 0), on to its neighbours while they
+      // decide (the step ends are monotone, the estimate is off by a step or two at most).
       const R te = R(opt_.t_eval[next_]);
       auto reached = [&](long j) { return dir_ * te <= dir_ * step_end(j); };
-      if (reached(last)) {
-        long lo = done, hi = last;  // not reached at lo (the last recorded step end), reached at hi
-        while (hi - lo > 1) {
-          const long mid = lo + (hi - lo) / 2;
-          (reached(mid) ? hi : lo) = mid;
-        }
-        end = std::min(end, hi - 1);
+      const double ahead = as_double(R(dir_ * (te - tp_))) / mean_step;
+      long j =
+          done + 1 + static_cast<long>(std::clamp(std::ceil(ahead) - 1, 0.0, static_cast<double>(last - done - 1)));
+      if (reached(j)) {
+        while (j - 1 > done && reached(j - 1)) --j;
+        end = std::min(end, j - 1);
+      } else {
+        while (j < last && !reached(j)) ++j;
+        if (reached(j)) end = std::min(end, j - 1);
       }
     }
     return std::max(0L, end - done);
@@ -755,7 +759,7 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
   for (long k = k0; k < n; ++k) {
     // Steps with nothing to record (Recorder::quiet_steps; none while a checkpoint is due) run as bare
     // engine steps, the same engine calls as below: the loop costs what a hand-written loop of them costs.
-    if (const long m = taken ? rec.quiet_steps(k, n - 1, step_end) : 0; m > 0) {
+    if (const long m = taken ? rec.quiet_steps(k, n - 1, step_end, as_double(h)) : 0; m > 0) {
       for (const long stop = k + m; k < stop; ++k) {
         integ.integrate(s, h, 1);
         if (!run.finite_in_engine(s)) {
