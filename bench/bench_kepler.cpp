@@ -26,8 +26,8 @@
 // The driver: solve() (solve/solve.hpp) with fixed steps, VV and M8, over kDriverPeriods periods of kSteps
 // steps, against the bare loop of the same engine steps (make_integrator, then step(s, h) in a for loop:
 // the engine calls solve() makes), in the same run; "saveat": the state saved at every kSaveEvery-th step
-// end (solve: those step ends as output times). Before the run, solve()'s states are checked to be bitwise
-// those of the bare loop. Target: solve / bare loop <= 1.05.
+// end (solve: those step ends as output times); "vector": on std::vector<double> states (the Python module). Before the
+// run, solve()'s states are checked to be bitwise those of the bare loop. Target: solve / bare loop <= 1.05.
 //
 //   bench_kepler --benchmark_repetitions=5     (the default here: 5 repetitions, 0.2 s each)
 #include <benchmark/benchmark.h>
@@ -277,15 +277,29 @@ double driver_t1() { return 2 * std::acos(-1.0) * kDriverPeriods; }
 double driver_h() { return driver_t1() / static_cast<double>(driver_steps()); }
 double driver_step_end(long j) { return j == driver_steps() ? driver_t1() : driver_h() * static_cast<double>(j); }
 
+using VD = std::vector<double>;  // the state of the Python module's built-in problems
+
 /// The saved times, positions and velocities of a run.
+template <class W>
 struct Saved {
   std::vector<double> t;
-  std::vector<V> q, v;
+  std::vector<W> q, v;
 };
 
+template <class W>
+State<W> start_as() {
+  const State<V> s = start();
+  return {W(s.q.begin(), s.q.end()), W(s.v.begin(), s.v.end())};
+}
+template <>
+State<V> start_as<V>() {
+  return start();
+}
+
 /// The bare loop: the engine steps one at a time, the state saved every `every` steps (0: only the end).
-State<V> bare_run(Integrator<V, KeplerForce>& integ, long every, Saved* out) {
-  State<V> s = start();
+template <class W>
+State<W> bare_run(Integrator<W, KeplerForce>& integ, long every, Saved<W>* out) {
+  State<W> s = start_as<W>();
   const double h = driver_h();
   const long n = driver_steps();
   for (long k = 0; k < n; ++k) {
@@ -309,23 +323,26 @@ SolveOptions driver_options(bool saveat) {
   return o;
 }
 
+template <class W>
 auto driver_problem() {
-  const State<V> s0 = start();
+  const State<W> s0 = start_as<W>();
   return SecondOrderProblem(KeplerForce{}, s0.q, s0.v, 0.0, driver_t1());
 }
 
+template <class W>
 void bm_bare(benchmark::State& state, const std::string& method, bool saveat) {
-  auto integ = make_integrator<V>(resolve_method(method), KeplerForce{});
+  auto integ = make_integrator<W>(resolve_method(method), KeplerForce{});
   for (auto _ : state) {
-    Saved out;
-    State<V> s = bare_run(integ, saveat ? kSaveEvery : 0, &out);
+    Saved<W> out;
+    State<W> s = bare_run(integ, saveat ? kSaveEvery : 0, &out);
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(out);
   }
 }
 
+template <class W>
 void bm_solve(benchmark::State& state, const std::string& method, bool saveat) {
-  const auto prob = driver_problem();
+  const auto prob = driver_problem<W>();
   const SolveOptions opt = driver_options(saveat);
   for (auto _ : state) {
     auto sol = solve(prob, method, opt);
@@ -338,10 +355,10 @@ bool check_driver() {
   bool ok = true;
   for (const auto& m : kDriverMethods) {
     auto integ = make_integrator<V>(resolve_method(m), KeplerForce{});
-    Saved bare;
+    Saved<V> bare;
     const State<V> end = bare_run(integ, kSaveEvery, &bare);
-    const auto sol = solve(driver_problem(), m, driver_options(true));
-    const auto sol_end = solve(driver_problem(), m, driver_options(false));
+    const auto sol = solve(driver_problem<V>(), m, driver_options(true));
+    const auto sol_end = solve(driver_problem<V>(), m, driver_options(false));
     const bool same = sol.t == bare.t && sol.q == bare.q && sol.v == bare.v && sol.q_final == end.q &&
                       sol.v_final == end.v && sol_end.q_final == end.q && sol_end.v_final == end.v;
     std::printf("check %-7s solve() vs the bare loop of its steps (%zu saved states): %s\n", m.c_str(), bare.t.size(),
@@ -389,19 +406,20 @@ class SummaryReporter : public bench::MinTimeReporter {
     }
     bool header = false;
     for (const auto& m : kDriverMethods) {
-      for (const char* kind : {"", "-saveat"}) {
+      for (const char* kind : {"", "-saveat", "-vector", "-vector-saveat"}) {
         const double* bare = best("bare" + std::string(kind) + "/" + m);
         const double* drv = best("solve" + std::string(kind) + "/" + m);
         if (!bare || !drv) continue;
         if (!header) {
           std::printf(
               "\nsolve() against the bare loop of its engine steps, %ld steps (%ld periods), default engine "
-              "options; saveat: every %ld-th step end saved\n%-10s %10s %10s %12s\n",
+              "options; saveat: every %ld-th step end saved; vector: std::vector<double> states\n%-17s %10s %10s "
+              "%12s\n",
               driver_steps(), kDriverPeriods, kSaveEvery, "method", "bare ns", "solve ns", "solve/bare");
           header = true;
         }
         const double per = static_cast<double>(kDriverPeriods);  // the reporter divides by kSteps
-        std::printf("%-10s %10.2f %10.2f %12.3f\n", (m + kind).c_str(), *bare / per, *drv / per, *drv / *bare);
+        std::printf("%-17s %10.2f %10.2f %12.3f\n", (m + kind).c_str(), *bare / per, *drv / per, *drv / *bare);
       }
     }
     if (header) std::printf("(target: solve / bare <= 1.05)\n");
@@ -431,10 +449,17 @@ int main(int argc, char** argv) {
     for (const bool saveat : {false, true}) {
       const std::string kind = saveat ? "-saveat/" : "/";
       benchmark::RegisterBenchmark(("bare" + kind + m).c_str(), [m, saveat](benchmark::State& s) {
-        bm_bare(s, m, saveat);
+        bm_bare<V>(s, m, saveat);
       })->MinTime(0.2);
       benchmark::RegisterBenchmark(("solve" + kind + m).c_str(), [m, saveat](benchmark::State& s) {
-        bm_solve(s, m, saveat);
+        bm_solve<V>(s, m, saveat);
+      })->MinTime(0.2);
+      const std::string vkind = saveat ? "-vector-saveat/" : "-vector/";
+      benchmark::RegisterBenchmark(("bare" + vkind + m).c_str(), [m, saveat](benchmark::State& s) {
+        bm_bare<VD>(s, m, saveat);
+      })->MinTime(0.2);
+      benchmark::RegisterBenchmark(("solve" + vkind + m).c_str(), [m, saveat](benchmark::State& s) {
+        bm_solve<VD>(s, m, saveat);
       })->MinTime(0.2);
     }
   }
