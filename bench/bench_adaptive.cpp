@@ -28,6 +28,7 @@
 #include "nystrom/engines/adaptive_mpe.hpp"
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 
 using namespace nystrom;
@@ -39,14 +40,7 @@ constexpr int kPeriods = 2;
 constexpr long kVvSteps = 2000;  // hand-VV: steps per period
 
 /// The Kepler force, counting its calls (the counter is outside the functor: engines copy it).
-struct CountingKepler {
-  long* calls;
-  template <class S>
-  void operator()(const std::array<S, 2>& q, std::array<S, 2>& a) const {
-    ++*calls;
-    KeplerForce{}(q, a);
-  }
-};
+using CountingKepler = CountingForce<KeplerForce>;
 
 /// Velocity Verlet, FSAL, the half kicks of consecutive steps merged; returns the force evaluations.
 template <class T>

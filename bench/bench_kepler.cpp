@@ -23,6 +23,12 @@
 // Target: ratio <= 1.10. Where the library has compensated summation (EngineOptions::compensated), it
 // is measured with its default options and with compensation off ("plain", like the hand-written loops).
 //
+// The driver: solve() (solve/solve.hpp) with fixed steps, VV and M8, over kDriverPeriods periods of kSteps
+// steps, against the bare loop of the same engine steps (make_integrator, then step(s, h) in a for loop:
+// the engine calls solve() makes), in the same run; "saveat": the state saved at every kSaveEvery-th step
+// end (solve: those step ends as output times); "vector": on std::vector<double> states (the Python module). Before the
+// run, solve()'s states are checked to be bitwise those of the bare loop. Target: solve / bare loop <= 1.05.
+//
 //   bench_kepler --benchmark_repetitions=5     (the default here: 5 repetitions, 0.2 s each)
 #include <benchmark/benchmark.h>
 
@@ -38,6 +44,7 @@
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
+#include "nystrom/solve/solve.hpp"
 
 using namespace nystrom;
 
@@ -258,6 +265,112 @@ bool check_hand_loops() {
   return ok;
 }
 
+// ---- the driver: solve() against the bare loop of its engine steps ----------------------------------------
+
+constexpr long kDriverPeriods = 50;
+constexpr long kSaveEvery = 20;
+const std::vector<std::string> kDriverMethods{"VV", "M8"};
+
+long driver_steps() { return kDriverPeriods * kSteps; }
+double driver_t1() { return 2 * std::acos(-1.0) * kDriverPeriods; }
+// solve()'s step size for {.steps = n} and the step ends it computes (t0 = 0).
+double driver_h() { return driver_t1() / static_cast<double>(driver_steps()); }
+double driver_step_end(long j) { return j == driver_steps() ? driver_t1() : driver_h() * static_cast<double>(j); }
+
+using VD = std::vector<double>;  // the state of the Python module's built-in problems
+
+/// The saved times, positions and velocities of a run.
+template <class W>
+struct Saved {
+  std::vector<double> t;
+  std::vector<W> q, v;
+};
+
+template <class W>
+State<W> start_as() {
+  const State<V> s = start();
+  return {W(s.q.begin(), s.q.end()), W(s.v.begin(), s.v.end())};
+}
+template <>
+State<V> start_as<V>() {
+  return start();
+}
+
+/// The bare loop: the engine steps one at a time, the state saved every `every` steps (0: only the end).
+template <class W>
+State<W> bare_run(Integrator<W, KeplerForce>& integ, long every, Saved<W>* out) {
+  State<W> s = start_as<W>();
+  const double h = driver_h();
+  const long n = driver_steps();
+  for (long k = 0; k < n; ++k) {
+    integ.step(s, h);
+    if (every > 0 && (k + 1) % every == 0) {
+      out->t.push_back(driver_step_end(k + 1));
+      out->q.push_back(s.q);
+      out->v.push_back(s.v);
+    }
+  }
+  return s;
+}
+
+SolveOptions driver_options(bool saveat) {
+  SolveOptions o{.steps = driver_steps(), .dense = false};
+  if (saveat) {
+    for (long j = kSaveEvery; j <= driver_steps(); j += kSaveEvery) o.t_eval.push_back(driver_step_end(j));
+  } else {
+    o.t_eval = {driver_t1()};
+  }
+  return o;
+}
+
+template <class W>
+auto driver_problem() {
+  const State<W> s0 = start_as<W>();
+  return SecondOrderProblem(KeplerForce{}, s0.q, s0.v, 0.0, driver_t1());
+}
+
+template <class W>
+void bm_bare(benchmark::State& state, const std::string& method, bool saveat) {
+  auto integ = make_integrator<W>(resolve_method(method), KeplerForce{});
+  for (auto _ : state) {
+    Saved<W> out;
+    State<W> s = bare_run(integ, saveat ? kSaveEvery : 0, &out);
+    benchmark::DoNotOptimize(s);
+    benchmark::DoNotOptimize(out);
+  }
+}
+
+template <class W>
+void bm_solve(benchmark::State& state, const std::string& method, bool saveat) {
+  const auto prob = driver_problem<W>();
+  const SolveOptions opt = driver_options(saveat);
+  for (auto _ : state) {
+    auto sol = solve(prob, method, opt);
+    benchmark::DoNotOptimize(sol);
+  }
+}
+
+/// solve() takes the engine steps of the bare loop: the same states, bit for bit.
+bool check_driver() {
+  bool ok = true;
+  for (const auto& m : kDriverMethods) {
+    auto integ = make_integrator<V>(resolve_method(m), KeplerForce{});
+    Saved<V> bare;
+    const State<V> end = bare_run(integ, kSaveEvery, &bare);
+    const auto sol = solve(driver_problem<V>(), m, driver_options(true));
+    const auto sol_end = solve(driver_problem<V>(), m, driver_options(false));
+    const bool same = sol.t == bare.t && sol.q == bare.q && sol.v == bare.v && sol.q_final == end.q &&
+                      sol.v_final == end.v && sol_end.q_final == end.q && sol_end.v_final == end.v;
+    std::printf("check %-7s solve() vs the bare loop of its steps (%zu saved states): %s\n", m.c_str(), bare.t.size(),
+                same ? "bitwise equal" : "DIFFERENT");
+    if (!same) {
+      std::fprintf(stderr, "error: solve() with %s does not take the bare loop's steps\n", m.c_str());
+      ok = false;
+    }
+  }
+  return ok;
+}
+
 /// The summary: minimum CPU time per step of every benchmark (bench_common.hpp), ratios to the hand loops.
 class SummaryReporter : public bench::MinTimeReporter {
  public:
@@ -291,6 +404,25 @@ class SummaryReporter : public bench::MinTimeReporter {
           *m8 / (10 * *vv));
       if (m8s) std::printf("M8 step (sequential products, plain) / 10 sequential forces: %.3f\n", *m8s / (10 * *vv));
     }
+    bool header = false;
+    for (const auto& m : kDriverMethods) {
+      for (const char* kind : {"", "-saveat", "-vector", "-vector-saveat"}) {
+        const double* bare = best("bare" + std::string(kind) + "/" + m);
+        const double* drv = best("solve" + std::string(kind) + "/" + m);
+        if (!bare || !drv) continue;
+        if (!header) {
+          std::printf(
+              "\nsolve() against the bare loop of its engine steps, %ld steps (%ld periods), default engine "
+              "options; saveat: every %ld-th step end saved; vector: std::vector<double> states\n%-17s %10s %10s "
+              "%12s\n",
+              driver_steps(), kDriverPeriods, kSaveEvery, "method", "bare ns", "solve ns", "solve/bare");
+          header = true;
+        }
+        const double per = static_cast<double>(kDriverPeriods);  // the reporter divides by kSteps
+        std::printf("%-17s %10.2f %10.2f %12.3f\n", (m + kind).c_str(), *bare / per, *drv / per, *drv / *bare);
+      }
+    }
+    if (header) std::printf("(target: solve / bare <= 1.05)\n");
   }
 };
 
@@ -313,8 +445,26 @@ int main(int argc, char** argv) {
                                    [&c](benchmark::State& s) { bm_library(s, c, {.plain = true, .sequential = true}); })
           ->MinTime(0.2);
   }
+  for (const auto& m : kDriverMethods) {
+    for (const bool saveat : {false, true}) {
+      const std::string kind = saveat ? "-saveat/" : "/";
+      benchmark::RegisterBenchmark(("bare" + kind + m).c_str(), [m, saveat](benchmark::State& s) {
+        bm_bare<V>(s, m, saveat);
+      })->MinTime(0.2);
+      benchmark::RegisterBenchmark(("solve" + kind + m).c_str(), [m, saveat](benchmark::State& s) {
+        bm_solve<V>(s, m, saveat);
+      })->MinTime(0.2);
+      const std::string vkind = saveat ? "-vector-saveat/" : "-vector/";
+      benchmark::RegisterBenchmark(("bare" + vkind + m).c_str(), [m, saveat](benchmark::State& s) {
+        bm_bare<VD>(s, m, saveat);
+      })->MinTime(0.2);
+      benchmark::RegisterBenchmark(("solve" + vkind + m).c_str(), [m, saveat](benchmark::State& s) {
+        bm_solve<VD>(s, m, saveat);
+      })->MinTime(0.2);
+    }
+  }
   if (!bench::initialize({argv, argv + argc}, 5)) return 1;  // five repetitions unless told otherwise
-  if (!check_hand_loops()) return 1;
+  if (!check_hand_loops() || !check_driver()) return 1;
   SummaryReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   reporter.summary();

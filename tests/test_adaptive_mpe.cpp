@@ -14,6 +14,7 @@
 
 #include "nystrom/engines/adaptive_mpe.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 
 using namespace nystrom;
@@ -23,17 +24,7 @@ namespace {
 using V2 = std::array<double, 2>;
 using VD = std::vector<double>;
 
-struct CountingKepler {
-  long* calls;
-  template <class V>
-  void operator()(const V& q, V& a) const {
-    ++*calls;
-    const double r2 = q[0] * q[0] + q[1] * q[1];
-    const double f = -1.0 / (r2 * std::sqrt(r2));
-    a[0] = f * q[0];
-    a[1] = f * q[1];
-  }
-};
+using CountingKepler = CountingForce<KeplerForce>;
 
 AdaptiveOptions with_tol(double tol) {
   AdaptiveOptions o;

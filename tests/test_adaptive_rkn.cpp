@@ -11,6 +11,7 @@
 
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 
 using namespace nystrom;
@@ -27,14 +28,7 @@ double max_error(const State<std::array<T, 2>>& a, const State<std::array<T, 2>>
   return static_cast<double>(e);
 }
 
-struct CountingKepler {
-  long* calls;
-  template <class S>
-  void operator()(const std::array<S, 2>& q, std::array<S, 2>& a) const {
-    ++*calls;
-    KeplerForce{}(q, a);
-  }
-};
+using CountingKepler = CountingForce<KeplerForce>;
 
 // q'' = 2 q^3, q(0) = 1, v(0) = 1: q = 1 / (1 - t), singular at t = 1.
 struct BlowUp {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "kepler_solve.hpp"
+#include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/solve.hpp"
 
@@ -247,6 +248,126 @@ TEST(Solve, AFailedRunReturnsTheStatesItReachedWhenAsked) {
     EXPECT_EQ(sol.t_final, sol.t.back());
     EXPECT_EQ(sol.q_final, sol.q.back());
   }
+}
+
+TEST(Solve, AFailedRunCountsTheForcesItEvaluated) {
+  // A force that counts its calls and returns NaN once q passes 0.5 (t = 1): every engine fails midway, and
+  // the partial result carries the forces evaluated up to the failure, the method's and the outputs' (dense
+  // output at every step end, or none) adding up to the calls the force received.
+  long calls = 0;
+  const auto nan_past_half = [](const Vd& q, Vd& a) { a[0] = q[0] > 0.5 ? NAN : 1.0; };
+  const SecondOrderProblem prob(CountingForce<VdForce>{&calls, nan_past_half}, Vd{0.0}, Vd{0.0}, 0.0, 2.0);
+  for (const std::string m : {"VV", "M8", "DP12-adaptive", "M10-adaptive", "GBS"}) {
+    for (const bool dense : {false, true}) {
+      SCOPED_TRACE(m + (dense ? " dense" : ""));
+      SolveOptions opt = m.find("adaptive") != std::string::npos || m == "GBS" ? SolveOptions{.rtol = 1e-10}
+                                                                               : SolveOptions{.steps = 100};
+      opt.dense = dense;
+      opt.max_steps = 2000;  // a failure either way: step size underflow or too many steps
+      opt.partial_on_failure = true;
+      calls = 0;
+      const auto sol = solve(prob, m, opt);
+      EXPECT_EQ(sol.status, SolveStatus::failed);
+      EXPECT_GT(sol.force_evals, 0);
+      EXPECT_EQ(sol.force_evals + sol.output_force_evals, calls);
+      if (!dense) {
+        EXPECT_EQ(sol.output_force_evals, 0);
+      }
+      EXPECT_GT(sol.accepted, 0);
+      EXPECT_LE(sol.t_final, 1.0 + 1e-12);
+    }
+  }
+  // Fixed steps with only the end as output time: q = t^2/2 passes 0.5 at t = 1 = 50 h, the run fails in the
+  // 50th or 51st step (by rounding) and counts what the engine stepped by hand to there counts.
+  calls = 0;
+  const auto vv = solve(prob, "VV", {.steps = 100, .t_eval = {2.0}, .dense = false, .partial_on_failure = true});
+  EXPECT_GE(vv.accepted, 49);
+  EXPECT_LE(vv.accepted, 50);
+  EXPECT_EQ(vv.force_evals, calls);
+  long by_hand = 0;
+  auto integ = make_integrator<Vd>(resolve_method("VV"), CountingForce<VdForce>{&by_hand, nan_past_half});
+  State<Vd> s{{0.0}, {0.0}};
+  for (long k = 0; k <= vv.accepted; ++k) integ.step(s, 0.02);
+  EXPECT_FALSE(std::isfinite(s.q[0]) && std::isfinite(s.v[0]));
+  EXPECT_EQ(vv.force_evals, by_hand);
+}
+
+TEST(Solve, StepsWithNothingToRecordAreTheEngineStepsBitwise) {
+  // Output times only (no events, no dense output): solve() runs the steps between two outputs as bare engine
+  // steps. The states are those of the engine stepped one step at a time by hand, bit for bit, forward and
+  // backward, with a step count or a step size (whose last step is shorter), and the same as with the dense
+  // output (which records every step end); output times inside a step are partial steps from its start.
+  for (const std::string m : {"VV", "M8"}) {
+    for (const int dir : {1, -1}) {
+      for (const bool by_h : {false, true}) {
+        SCOPED_TRACE(m + (dir > 0 ? " forward" : " backward") + (by_h ? " h" : " steps"));
+        const double t1 = dir * 10.3;
+        const auto prob = kepler(0.5, 0.0, t1);
+        const long n = 400;
+        const double h = by_h ? 10.3 / (n - 0.5) : 10.3 / n;  // by h: the last step is half as long
+        auto end = [&](long j) { return j == n ? t1 : dir * (h * static_cast<double>(j)); };
+        SolveOptions opt{.t_eval = {end(7), end(8), end(150), end(151) - dir * h / 3, end(399), t1}, .dense = false};
+        if (by_h)
+          opt.h = h;
+        else
+          opt.steps = n;
+        long beats = 0;
+        opt.on_step = [&](double) { ++beats; };
+        opt.on_step_every = 64;
+        const auto quiet = solve(prob, m, opt);
+        opt.dense = true;
+        const auto every_step = solve(prob, m, opt);
+        EXPECT_EQ(beats, 2 * (n / 64));
+        ASSERT_EQ(quiet.t.size(), opt.t_eval.size());
+        EXPECT_EQ(quiet.t, every_step.t);
+        EXPECT_EQ(quiet.q, every_step.q);
+        EXPECT_EQ(quiet.v, every_step.v);
+        EXPECT_EQ(quiet.accepted, n);
+        EXPECT_EQ(quiet.force_evals, every_step.force_evals);
+        // By hand: the engine on the time-reversed problem (q, -v), one step at a time.
+        auto integ = make_integrator<V2>(resolve_method(m), KeplerForce{});
+        State<V2> s{prob.q0, {dir * prob.v0[0], dir * prob.v0[1]}};
+        std::vector<V2> qs;
+        for (long k = 0; k < n; ++k) {
+          integ.step(s, k == n - 1 && by_h ? 10.3 - h * (n - 1) : h);
+          if (k + 1 == 7 || k + 1 == 8 || k + 1 == 150 || k + 1 == 399 || k + 1 == n) qs.push_back(s.q);
+        }
+        EXPECT_EQ(quiet.q[0], qs[0]);
+        EXPECT_EQ(quiet.q[1], qs[1]);
+        EXPECT_EQ(quiet.q[2], qs[2]);
+        EXPECT_EQ(quiet.q[4], qs[3]);
+        EXPECT_EQ(quiet.q[5], qs[4]);
+        EXPECT_EQ(quiet.q_final, qs[4]);
+        EXPECT_EQ(quiet.v_final[0], dir * s.v[0]);
+        EXPECT_NEAR(quiet.q[3][0], every_step(quiet.t[3]).q[0], 0.0);  // a partial step, as sol(t)
+      }
+    }
+  }
+}
+
+TEST(Solve, OnStepRunsEveryNthStepAndItsExceptionEndsTheRunThere) {
+  long calls = 0;
+  const auto s0 = KeplerProblem<double>(0.5).initial_state();
+  const SecondOrderProblem prob(CountingForce<KeplerForce>{&calls}, s0.q, s0.v, 0.0, 100.0);
+  struct Stop {};
+  std::vector<double> seen;
+  SolveOptions opt{.steps = 10000, .t_eval = {100.0}, .dense = false};
+  opt.on_step_every = 1000;
+  opt.on_step = [&](double t) {
+    seen.push_back(t);
+    if (seen.size() == 3) throw Stop{};
+  };
+  EXPECT_THROW(solve(prob, "VV", opt), Stop);
+  ASSERT_EQ(seen.size(), 3u);
+  EXPECT_DOUBLE_EQ(seen[2], 30.0);
+  // The run stopped right there: the forces of 3000 steps of VV.
+  long by_hand = 0;
+  auto integ = make_integrator<V2>(resolve_method("VV"), CountingForce<KeplerForce>{&by_hand});
+  State<V2> s = s0;
+  for (long k = 0; k < 3000; ++k) integ.step(s, 0.01);
+  EXPECT_EQ(calls, by_hand);
+  opt.on_step_every = 0;
+  EXPECT_THROW(solve(prob, "VV", opt), invalid_input);
 }
 
 namespace {

@@ -35,6 +35,7 @@
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 
 namespace nystrom::peers {
@@ -49,17 +50,16 @@ struct BudgetExceeded {};
 struct ForceCounter {
   long calls = 0;
   long cap = std::numeric_limits<long>::max();
+  /// One more call (CountingForce), BudgetExceeded past the cap.
+  ForceCounter& operator++() {
+    if (++calls > cap) throw BudgetExceeded{};
+    return *this;
+  }
 };
 
 /// a = -q/|q|^3, counting its calls. Copies share the counter, so the count is right whatever the
 /// integrator does with the functor it is given.
-struct CountingKepler {
-  ForceCounter* counter;
-  void operator()(const Vec2& q, Vec2& a) const {
-    if (++counter->calls > counter->cap) throw BudgetExceeded{};
-    KeplerForce{}(q, a);
-  }
-};
+using CountingKepler = CountingForce<KeplerForce, ForceCounter>;
 
 /// The same force as the first-order system y' = (v, a(q)) of odeint's Runge-Kutta steppers.
 struct CountingKeplerSystem {

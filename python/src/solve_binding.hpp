@@ -193,13 +193,11 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   const bool release = !python_force && events.empty() && mpfr_bits == 0;
   SolveOptions opt = r.options;
   opt.partial_on_failure = true;  // a failed run returns the states it reached, with status -1
-  // Interruption checks (Ctrl-C) and progress every `every` steps: about 2^22 coordinate updates apart,
+  // Interruption checks (Ctrl-C) and progress every on_step_every steps: about 2^22 coordinate updates apart,
   // or every 64 steps when Python runs at every step anyway.
   const long work = static_cast<long>(m) * std::max(1, r.method.info.forces_per_step);
-  const long every = release ? std::max(1L, (1L << 22) / std::max(1L, work)) : 64;
-  long count = 0;
+  opt.on_step_every = release ? std::max(1L, (1L << 22) / std::max(1L, work)) : 64;
   opt.on_step = [&](double t) {
-    if (++count % every != 0) return;
     auto beat = [&] {
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
       if (!r.progress.is_none()) r.progress(t);

@@ -16,12 +16,13 @@
 
 namespace nystrom {
 
-/// Force functor: works for any real or complex scalar (complex square root for complex q).
+/// Force functor: works for any real or complex scalar (complex square root for complex q), on a
+/// std::array<S, 2> or any container of two coordinates (std::vector<S>).
 /// Real scalars form 1/r^3 by inv_r3 (core/scalar.hpp: S(1) / (r2 sqrt(r2)), so -inv_r3 is bitwise
 /// S(-1) / (r2 r) in every correctly rounded type; double-double and quad-double have their own).
 struct KeplerForce {
-  template <class S>
-  void operator()(const std::array<S, 2>& q, std::array<S, 2>& a) const {
+  template <class V, class S = typename V::value_type>
+  void operator()(const V& q, V& a) const {
     const S r2 = q[0] * q[0] + q[1] * q[1];
     const S minv = [&] {
       if constexpr (is_complex_v<S>) {

@@ -30,6 +30,7 @@
 #include <cmath>
 #include <complex>
 #include <cstddef>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -48,6 +49,7 @@
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/counting_force.hpp"
 #include "nystrom/solve/checkpoint.hpp"
 #include "nystrom/solve/dense.hpp"
 #include "nystrom/solve/problem.hpp"
@@ -87,12 +89,16 @@ struct SolveOptions {
   /// Called with the checkpoint as text (to_text; float, double and long double states) when it is
   /// taken, if set: e.g. to write it to a file (write_checkpoint_text) while the run goes on.
   std::function<void(const std::string& checkpoint_text)> on_checkpoint{};
-  /// Called at every accepted step end with its time, if set (a progress display, an interruption
-  /// check); an exception it throws ends the run and leaves solve() unchanged.
+  /// Called at every on_step_every-th accepted step end of the call (counted from its start) with its
+  /// time, if set (a progress display, an interruption check); an exception it throws ends the run and
+  /// leaves solve() unchanged. Fixed steps between two calls with nothing else to record (no events, no
+  /// dense output, no output time, no checkpoint due) run as a loop of bare engine steps.
   std::function<void(double t)> on_step{};
+  long on_step_every = 1;
   /// When a run fails (step_size_underflow, too_many_steps, a state no longer finite: a nystrom::error
   /// other than invalid_input), return what it reached instead of throwing: the saved states up to the
-  /// failure (every step end, or the output times passed), status `failed` and the error's message.
+  /// failure (every step end, or the output times passed), status `failed`, the error's message, and the
+  /// force evaluations and accepted steps up to the failure.
   bool partial_on_failure = false;
 };
 
@@ -127,6 +133,7 @@ struct Solution {
   real_type t_final{};
   V q_final, v_final;
   long force_evals = 0;         // by the method: every stage, rejected steps and starting-step estimates
+                                // (a failed run: those up to the failure)
   long output_force_evals = 0;  // at step ends for the dense output and events
   long accepted = 0, rejected = 0;
   SolveStatus status = SolveStatus::success;
@@ -243,6 +250,7 @@ class Recorder {
            PartialStep partial)
       : prob_(prob), opt_(opt), events_(events), sol_(sol), dir_(dir), partial_(std::move(partial)) {
     need_a_ = opt.dense || !events.empty();
+    if (opt.on_step_every <= 0) throw invalid_input("on_step_every must be positive");
     for (const auto& e : events_)
       if (!e.g) throw invalid_input("event '" + e.name + "' has no function");
     if (opt.dense) sol_.dense.set_partial_step(partial_);
@@ -267,8 +275,9 @@ class Recorder {
   /// A step ended at (t, q, v); true when a terminal event ends the run inside it (the solution's
   /// final state is then set to the event's).
   bool step(const R& t, const V& q, const V& v) {
-    if (opt_.on_step) opt_.on_step(as_double(t));
-    V a = q;
+    ++steps_;
+    if (opt_.on_step && steps_ % opt_.on_step_every == 0) opt_.on_step(as_double(t));
+    V& a = a_;
     if (need_a_) accel(t, q, a);
     // Events in this step, the earliest first.
     std::vector<std::pair<R, std::size_t>> hits;
@@ -317,10 +326,52 @@ class Recorder {
     tp_ = t;
     assign_v(qp_, q);
     assign_v(vp_, v);
-    assign_v(ap_, a);
+    if (need_a_) assign_v(ap_, a);
     gp_ = g;
     return terminal;
   }
+
+  /// The number of steps from the last step end that need nothing of the recorder but the state where
+  /// they end (quiet(), with step_end(j): the time at the end of the j-th step of the run, monotone in
+  /// j): none with events or dense output (every step end is needed) or without output times (every
+  /// step end is saved); else up to the step before the one that reaches the next output time or ends
+  /// on a call of on_step. `done`: steps of the run so far; `last`: the last step of the run that may
+  /// be quiet; `mean_step`: the step size, for a first guess.
+  template <class StepEnd>
+  long quiet_steps(long done, long last, StepEnd&& step_end, double mean_step) const {
+    if (need_a_ || opt_.t_eval.empty() || last <= done) return 0;
+    long end = last;  // the first step end that must be recorded lies after `end`
+    if (opt_.on_step) end = std::min(end, done + (opt_.on_step_every - steps_ % opt_.on_step_every) - 1);
+    if (next_ < opt_.t_eval.size()) {
+      // The first step end j in (done, last] at or past the next output time: from the step end nearest
+      // to it by the step size (mean_step: the span of a step, > 0), on to its neighbours while they
+      // decide (the step ends are monotone, the estimate is off by a step or two at most).
+      const R te = R(opt_.t_eval[next_]);
+      auto reached = [&](long j) { return dir_ * te <= dir_ * step_end(j); };
+      const double ahead = as_double(R(dir_ * (te - tp_))) / mean_step;
+      long j =
+          done + 1 + static_cast<long>(std::clamp(std::ceil(ahead) - 1, 0.0, static_cast<double>(last - done - 1)));
+      if (reached(j)) {
+        while (j - 1 > done && reached(j - 1)) --j;
+        end = std::min(end, j - 1);
+      } else {
+        while (j < last && !reached(j)) ++j;
+        if (reached(j)) end = std::min(end, j - 1);
+      }
+    }
+    return std::max(0L, end - done);
+  }
+
+  /// `count` steps ended with nothing to record (quiet_steps), the last of them at (t, q, v).
+  void quiet(long count, const R& t, const V& q, const V& v) {
+    steps_ += count;
+    tp_ = t;
+    assign_v(qp_, q);
+    assign_v(vp_, v);
+  }
+
+  /// Accepted step ends seen by this recorder (step() and quiet()).
+  long steps() const { return steps_; }
 
  private:
   static void assign_v(V& x, const V& y) {
@@ -412,8 +463,9 @@ class Recorder {
   PartialStep partial_;
   bool need_a_ = true;
   std::size_t next_ = 0;
+  long steps_ = 0;
   R tp_{};
-  V qp_{}, vp_{}, ap_{};
+  V qp_{}, vp_{}, ap_{}, a_{};
   std::vector<R> gp_;
 };
 
@@ -442,8 +494,10 @@ struct Conversion {
     return s;
   }
   void from_engine(const State<VE>& s, V& q, V& v) const {
-    q = make_vector<V>(n);
-    v = make_vector<V>(n);
+    if constexpr (!is_std_array<V>::value) {
+      q.resize(n);
+      v.resize(n);
+    }
     for (std::size_t i = 0; i < n; ++i) {
       if constexpr (is_complex_v<S>) {
         q[i] = s.q[i].real();
@@ -545,9 +599,23 @@ struct Run {
     return partial_step(Integrator<VE, Force>(data, force(), opt.engine));
   }
   void check_finite(const V& q, const V& v, const R& ta, const R& tb) const {
-    if (!all_finite(q) || !all_finite(v))
-      throw error("the state became NaN or infinite in the step from t = " + adaptive_detail::sci(as_double(ta)) +
-                  " to t = " + adaptive_detail::sci(as_double(tb)) + " (the force returned NaN or infinity)");
+    if (!all_finite(q) || !all_finite(v)) throw not_finite(ta, tb);
+  }
+  /// Whether the user's coordinates of engine state s (the real parts) are finite: check_finite without
+  /// the conversion.
+  bool finite_in_engine(const State<VE>& s) const {
+    for (std::size_t i = 0; i < n; ++i) {
+      if constexpr (is_complex_v<typename VE::value_type>) {
+        if (!is_finite_scalar(s.q[i].real()) || !is_finite_scalar(s.v[i].real())) return false;
+      } else {
+        if (!is_finite_scalar(s.q[i]) || !is_finite_scalar(s.v[i])) return false;
+      }
+    }
+    return true;
+  }
+  static error not_finite(const R& ta, const R& tb) {
+    return error("the state became NaN or infinite in the step from t = " + adaptive_detail::sci(as_double(ta)) +
+                 " to t = " + adaptive_detail::sci(as_double(tb)) + " (the force returned NaN or infinity)");
   }
   /// Restores the state of a checkpoint into s.
   void restore(const Checkpoint<R>& c, State<VE>& s) const {
@@ -679,11 +747,35 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
   rec.start(tstart, q, v);
   bool taken = !std::isfinite(opt.checkpoint_at);
   R tprev = tstart;
+  // The user's time at the end of the j-th step (the last one ends on t1).
+  auto step_end = [&](long j) -> R { return j == n ? prob.t1 : sgn_mul(dir, R(tau0 + h * R(j))); };
+  // A failed run reports the forces evaluated up to the failure.
+  struct CountOnExit {
+    Solution<V>& sol;
+    const Integrator<VE, typename Run<V, F, VE>::Force>& engine;
+    long evals0;
+    ~CountOnExit() { sol.force_evals = evals0 + engine.force_evals(); }
+  } count_on_exit{sol, integ, evals0};
   for (long k = k0; k < n; ++k) {
+    // Steps with nothing to record (Recorder::quiet_steps; none while a checkpoint is due) run as bare
+    // engine steps, the same engine calls as below: the loop costs what a hand-written loop of them costs.
+    if (const long m = taken ? rec.quiet_steps(k, n - 1, step_end, as_double(h)) : 0; m > 0) {
+      for (const long stop = k + m; k < stop; ++k) {
+        integ.integrate(s, h, 1);
+        if (!run.finite_in_engine(s)) {
+          sol.accepted = k;
+          throw run.not_finite(step_end(k), step_end(k + 1));
+        }
+      }
+      tprev = step_end(k);
+      run.from_engine(s, q, v);
+      sol.accepted = k;
+      rec.quiet(m, tprev, q, v);
+    }
     // The last step of a given h ends on t1.
     const R hk = (opt.steps <= 0 && k == n - 1) ? R((tau1 - tau0) - h * R(n - 1)) : h;
     integ.integrate(s, hk, 1);
-    const R t = k == n - 1 ? prob.t1 : sgn_mul(dir, R(tau0 + h * R(k + 1)));
+    const R t = step_end(k + 1);
     run.from_engine(s, q, v);
     run.check_finite(q, v, tprev, t);
     sol.accepted = k + 1;
@@ -707,7 +799,6 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
       run.take(c, sol);
     }
   }
-  sol.force_evals = evals0 + integ.force_evals();
   if (sol.status == SolveStatus::success) {
     sol.t_final = prob.t1;
     sol.q_final = q;
@@ -715,10 +806,12 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
   }
 }
 
-/// Adaptive RKN or MPE (Engine: AdaptiveRknIntegrator or AdaptiveMpeIntegrator on VE).
+/// Adaptive RKN or MPE (Engine: AdaptiveRknIntegrator or AdaptiveMpeIntegrator on VE, its force counting
+/// its calls in `calls`: the engines add up their own counts when a call returns, a failed run reports these).
 template <class VE, class V, class F, class Engine>
-void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, const MethodDef& def, Solution<V>& sol,
-                  const std::vector<Event<V>>& events, const Checkpoint<real_t<typename V::value_type>>* resume) {
+void run_adaptive(Run<V, F, VE>& run, Engine& engine, const long& calls, const char* name, const MethodDef& def,
+                  Solution<V>& sol, const std::vector<Event<V>>& events,
+                  const Checkpoint<real_t<typename V::value_type>>* resume) {
   using R = real_t<typename V::value_type>;
   auto& prob = run.prob;
   const int dir = run.dir;
@@ -742,6 +835,17 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const char* name, const Me
     sol.output_force_evals = resume->output_force_evals;
   }
   Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir, run.propagated_method(def));
+  struct CountOnFailure {
+    Solution<V>& sol;
+    const Recorder<V, SecondOrderProblem<V, F>>& rec;
+    const long& calls;
+    long evals0, acc0;
+    ~CountOnFailure() {
+      if (std::uncaught_exceptions() == 0) return;
+      sol.force_evals = evals0 + calls;
+      sol.accepted = acc0 + rec.steps();
+    }
+  } count_on_failure{sol, rec, calls, evals0, acc0};
   drive_engine(
       run, rec, sol, sgn_mul(dir, tau), s,
       [&](const R& tt) -> std::optional<R> {
@@ -809,6 +913,15 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
     t_start = resume->t;
     sol.output_force_evals = resume->output_force_evals;
   }
+  struct CountOnExit {  // also a failed run: the counts up to the failure
+    Solution<V>& sol;
+    const GbsIntegrator<VE, typename Run<V, F, VE>::Force>& g;
+    ~CountOnExit() {
+      sol.force_evals = g.force_evals();
+      sol.accepted = g.steps();
+      sol.rejected = g.rejected();
+    }
+  } count_on_exit{sol, g};
   drive_engine(
       run, rec, sol, t_start, s,
       [&](const R& trel) -> std::optional<R> { return trel == span ? prob.t1 : sgn_mul(dir, R(tau0 + trel)); },
@@ -827,9 +940,6 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
         c.accepted = g.steps();
         c.rejected = g.rejected();
       });
-  sol.force_evals = g.force_evals();
-  sol.accepted = g.steps();
-  sol.rejected = g.rejected();
 }
 
 /// The run of solve_impl with the method's engine, into sol.
@@ -852,12 +962,14 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
       ao.tol = opt.rtol;
       ao.atol = opt.atol;
       ao.max_steps = opt.max_steps;
+      long calls = 0;
+      using Counted = CountingForce<typename Run<V, F, VE>::Force>;
       if (std::holds_alternative<MpeDef>(def.build())) {
-        auto engine = make_adaptive_mpe_integrator<VE>(def, run.force(), ao, opt.engine);
-        run_adaptive<VE>(run, engine, "adaptive-mpe", def, sol, events, resume);
+        auto engine = make_adaptive_mpe_integrator<VE>(def, Counted{&calls, run.force()}, ao, opt.engine);
+        run_adaptive<VE>(run, engine, calls, "adaptive-mpe", def, sol, events, resume);
       } else {
-        auto engine = make_adaptive_integrator<VE>(def, run.force(), ao, opt.engine);
-        run_adaptive<VE>(run, engine, "adaptive-rkn", def, sol, events, resume);
+        auto engine = make_adaptive_integrator<VE>(def, Counted{&calls, run.force()}, ao, opt.engine);
+        run_adaptive<VE>(run, engine, calls, "adaptive-rkn", def, sol, events, resume);
       }
     }
   } else if (def.info.complex) {
