@@ -350,8 +350,8 @@ TEST(KeplerDrift, ManyOrbitsAtOnceMatchLongDouble) {
 
 // Random orbits (positions in the unit cube, speeds over three decades, mu over two, |dt| from 1e-3 to 1e3, both
 // signs; elliptic and hyperbolic): every drift converges and matches long double to rounding amplified by the
-// drift's length. The bracketed iteration used to accept an infinite F or r (a far guess on a hyperbola, where the
-// G-functions overflow) as converged and to loosen its bracket, and failed on about one in ten of such orbits.
+// drift's length. A bracketed iteration that takes an infinite F or r (a far guess on a hyperbola, where the
+// G-functions overflow) for converged, or loosens its bracket on it, fails on about one in ten of such orbits.
 TEST(KeplerDrift, RandomOrbitsConvergeAndMatchLongDouble) {
   std::mt19937_64 rng(12345);
   auto uniform = [&rng] { return static_cast<double>(rng() >> 11) * 0x1p-52 - 1; };  // in [-1, 1)
