@@ -19,7 +19,7 @@ int main() {
   const std::vector<nystrom::Event<V>> events = {
       {.name = "bottom", .g = [](double, const V& q, const V&) { return q[0]; }, .direction = +1}};
 
-  const auto sol = nystrom::solve(problem, "M12-adaptive", {.rtol = 1e-12, .t_eval = times}, events);
+  const auto sol = nystrom::solve(problem, "M12-adaptive", {.rtol = 1e-12, .t_eval = times, .dense = true}, events);
 
   std::printf("%8s %14s %14s\n", "t", "theta", "theta'");
   for (std::size_t i = 0; i < sol.t.size(); ++i)

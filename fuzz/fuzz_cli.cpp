@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "nystrom/analysis/method_file.hpp"
 
 namespace {
 
@@ -64,6 +65,8 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static const bool reader = (nystrom::analysis::register_method_file_reader(), true);  // as the tool's main()
+  (void)reader;
   if (size > 4096) return 0;
   std::vector<std::string> args{"nystrom"};
   std::string cur;

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "nystrom/analysis/method_file.hpp"  // installs the reader of "file:" method specifications
+#include "nystrom/analysis/method_file.hpp"
 #include "nystrom/methods/catalog.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -16,7 +16,7 @@
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/planetary/system.hpp"
 #include "nystrom/planetary/wisdom_holman.hpp"
-#include "nystrom/solve.hpp"
+#include "nystrom/solve/solve.hpp"
 #include "runner.hpp"
 
 namespace nystrom::cli {

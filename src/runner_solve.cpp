@@ -10,7 +10,7 @@
 
 #include "cli.hpp"
 #include "nystrom/problems/kepler.hpp"
-#include "nystrom/solve.hpp"
+#include "nystrom/solve/solve.hpp"
 #include "runner_solve.hpp"
 
 namespace nystrom::cli {

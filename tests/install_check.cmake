@@ -16,7 +16,7 @@ if(DOWNSTREAM_FLAGS)
   set(build_type "")
 endif()
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples -B ${WORK_DIR}/build
-                        -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=${build_type}
+                        -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=${build_type} -DCMAKE_CXX_COMPILER=${CXX}
                         "-DCMAKE_CXX_FLAGS=${DOWNSTREAM_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${DOWNSTREAM_FLAGS}"
                 RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
@@ -33,5 +33,21 @@ endif()
 execute_process(COMMAND ${WORK_DIR}/build/pendulum_solve RESULT_VARIABLE rc OUTPUT_VARIABLE out2)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the example pendulum_solve failed: ${out2}")
+endif()
+# The one-line build of the README: a program that uses solve() in double needs the headers and libnystrom only.
+separate_arguments(flags UNIX_COMMAND "${DOWNSTREAM_FLAGS}")
+if(NOT DOWNSTREAM_FLAGS)
+  set(flags -O2)
+endif()
+execute_process(COMMAND ${CXX} -std=c++20 ${flags} -I${WORK_DIR}/prefix/include ${SOURCE_DIR}/examples/pendulum_solve.cpp
+                        -o ${WORK_DIR}/pendulum_one_line -L${WORK_DIR}/prefix/lib -Wl,-rpath,${WORK_DIR}/prefix/lib
+                        -lnystrom
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the one-line build of examples/pendulum_solve.cpp failed: ${err}")
+endif()
+execute_process(COMMAND ${WORK_DIR}/pendulum_one_line RESULT_VARIABLE rc OUTPUT_VARIABLE out3)
+if(NOT rc EQUAL 0 OR NOT out3 STREQUAL out2)
+  message(FATAL_ERROR "the one-line build of pendulum_solve runs differently: ${out3}")
 endif()
 message(STATUS "installed package works:\n${out}${out2}")

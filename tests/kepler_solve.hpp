@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "nystrom/problems/kepler.hpp"
-#include "nystrom/solve.hpp"
+#include "nystrom/solve/solve.hpp"
 
 namespace nystrom::test {
 

@@ -17,6 +17,9 @@ using namespace nystrom::analysis;
 
 namespace {
 
+// `file:PATH` specifications need the reader, registered explicitly as the tool and the module do.
+const bool reader_registered = (register_method_file_reader(), true);
+
 std::filesystem::path temp_file(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / ("nystrom-mf-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

@@ -135,7 +135,7 @@ template <>
 struct scalar_traits<DualQd4> {
   static std::string name() { return "dual4<qd>"; }
   static long bits() { return scalar_traits<quad_double>::bits(); }
-  static DualQd4 from_mpfr(mpfr_srcptr x) { return DualQd4(scalar_traits<quad_double>::from_mpfr(x)); }
+  static DualQd4 from_mpfr(mpfr_srcptr x) { return DualQd4(from_mpfr_as<quad_double>(x)); }
 };
 }  // namespace nystrom
 

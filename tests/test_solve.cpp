@@ -13,7 +13,7 @@
 #include "kepler_solve.hpp"
 #include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
-#include "nystrom/solve.hpp"
+#include "nystrom/solve/solve.hpp"
 
 using namespace nystrom;
 using nystrom::test::kepler;

@@ -19,7 +19,7 @@
 
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/analysis/bch_report.hpp"
-#include "nystrom/analysis/method_file.hpp"  // installs the reader of "file:" method specifications
+#include "nystrom/analysis/method_file.hpp"
 #include "nystrom/engines/mpe.hpp"
 #include "nystrom/experiments/kepler.hpp"
 #include "nystrom/methods/catalog.hpp"
@@ -171,6 +171,7 @@ std::vector<double> flat(const DArray& a) { return std::vector<double>(a.data(),
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "Compiled core of nystrom: the method catalog and the integrators (use the nystrom package).";
+  nystrom::analysis::register_method_file_reader();  // `file:PATH` method specifications
 
   m.def(
       "methods",

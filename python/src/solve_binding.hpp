@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "nystrom/core/extended.hpp"
-#include "nystrom/solve.hpp"
+#include "nystrom/solve/solve.hpp"
 
 namespace nystrom::python {
 

@@ -327,8 +327,8 @@ inline std::string format_method_file(const std::string& name, int order, const 
   return o.str();
 }
 
-/// Installs method_def_from_file as the reader of "file:PATH" specifications (methods/catalog.hpp) in
-/// every program that includes this header.
-inline const bool method_file_reader_installed = (set_method_file_reader(&method_def_from_file), true);
+/// Installs method_def_from_file as the reader of "file:PATH" specifications (methods/catalog.hpp): a
+/// program that accepts method files calls it once at start (the tool and the Python module do).
+inline void register_method_file_reader() { set_method_file_reader(&method_def_from_file); }
 
 }  // namespace nystrom::analysis

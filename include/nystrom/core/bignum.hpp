@@ -11,6 +11,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include <boost/multiprecision/mpfr.hpp>
 
@@ -101,10 +102,23 @@ inline bigfloat big(const std::string& text) {
 
 inline bigcomplex bigc(const std::string& re, const std::string& im = "0") { return {big(re), big(im)}; }
 
+/// An MPFR value rounded to a real working type T: MPFR's own conversions for double and long double,
+/// scalar_traits<T>::from_mpfr for the others (core/extended.hpp).
+template <class T>
+T from_mpfr_as(mpfr_srcptr x) {
+  if constexpr (std::is_same_v<T, double>) {
+    return mpfr_get_d(x, MPFR_RNDN);
+  } else if constexpr (std::is_same_v<T, long double>) {
+    return mpfr_get_ld(x, MPFR_RNDN);
+  } else {
+    return scalar_traits<T>::from_mpfr(x);
+  }
+}
+
 /// Converts a reference value to a real working type (correct rounding where MPFR provides it).
 template <class T>
 T to_real(const bigfloat& x) {
-  return scalar_traits<T>::from_mpfr(x.backend().data());
+  return from_mpfr_as<T>(x.backend().data());
 }
 
 /// Converts a reference complex value to a working scalar S (real or std::complex).

@@ -479,6 +479,17 @@ inline long parse_mpfr_bits(const std::string& text) {
   return bits;
 }
 
+// ---- compiled in libnystrom (solve/compiled.hpp) -----------------------------------------------
+
+template <>
+struct is_compiled_scalar<float128> : std::true_type {};
+template <>
+struct is_compiled_scalar<double_double> : std::true_type {};
+template <>
+struct is_compiled_scalar<quad_double> : std::true_type {};
+template <>
+struct is_compiled_scalar<mpfr_real> : std::true_type {};
+
 // ---- scalar_traits ----------------------------------------------------------------------------
 
 template <>

@@ -4,7 +4,8 @@
 // customisation points the engines and the catalog need:
 //   * real_t<S>            the real type underlying S (S itself, or T for std::complex<T>)
 //   * is_complex_v<S>
-//   * scalar_traits<T>     name, mantissa bits, conversion from an MPFR reference value
+//   * scalar_traits<T>     name, mantissa bits (and, for the extended types, from_mpfr: see from_mpfr_as
+//                          in core/bignum.hpp)
 //   * real_part(x)         projection used by complex-coefficient methods
 //   * inv_r3(r2)           r2^(-3/2), the r^-3 of inverse-square forces (overloaded for dd and qd)
 // double and long double are defined here; extended types (float128, dd_real, qd_real,
@@ -16,8 +17,6 @@
 #include <limits>
 #include <string>
 #include <type_traits>
-
-#include <mpfr.h>
 
 namespace nystrom {
 
@@ -47,15 +46,19 @@ template <>
 struct scalar_traits<double> {
   static std::string name() { return "double"; }
   static long bits() { return std::numeric_limits<double>::digits; }
-  static double from_mpfr(mpfr_srcptr x) { return mpfr_get_d(x, MPFR_RNDN); }
 };
 
 template <>
 struct scalar_traits<long double> {
   static std::string name() { return "long-double"; }
   static long bits() { return std::numeric_limits<long double>::digits; }
-  static long double from_mpfr(mpfr_srcptr x) { return mpfr_get_ld(x, MPFR_RNDN); }
 };
+
+/// The real scalar types for which libnystrom compiles solve() on std::vector states (solve/compiled.hpp):
+/// double and long double here, the extended types in core/extended.hpp. Others run on the inline path
+/// (nystrom/solve_inline.hpp).
+template <class T>
+struct is_compiled_scalar : std::bool_constant<std::is_same_v<T, double> || std::is_same_v<T, long double>> {};
 
 /// Machine epsilon of a real scalar type, 2^(1-bits).
 template <class T>

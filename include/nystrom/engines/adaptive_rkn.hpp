@@ -72,39 +72,13 @@
 #include "nystrom/core/bignum.hpp"
 #include "nystrom/core/error.hpp"
 #include "nystrom/core/state.hpp"
+#include "nystrom/engines/options.hpp"
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/methods/method.hpp"
 #include "nystrom/methods/method_data.hpp"
 #include "nystrom/methods/rkn_order_conditions.hpp"
 
 namespace nystrom {
-
-struct AdaptiveOptions {
-  double tol = 1e-10;         // relative tolerance, and the absolute one when atol is 0 (see the norm above)
-  double atol = 0;            // absolute tolerance; 0 (or equal to tol): the mixed norm with tol alone
-  double safety = 0.9;        // safety factor on the optimal step (see below)
-  double fac_min = 0.2;       // smallest step ratio per step
-  double fac_max = 4.0;       // largest step ratio per step
-  double h0 = 0.0;            // first step; 0: automatic
-  double h_max = 0.0;         // largest step; 0: |t1 - t0|
-  long max_steps = 10000000;  // accepted + rejected steps per integrate_to call
-  int error_order = 0;        // p, the lower order of the pair; 0: determined from the tableau
-  bool predictive = true;     // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
-
-  void validate() const {
-    if (!std::isfinite(tol) || !(tol >= 0)) throw std::invalid_argument("tolerance must be a finite number >= 0");
-    if (!std::isfinite(atol) || !(atol >= 0))
-      throw std::invalid_argument("absolute tolerance must be a finite number >= 0");
-    if (!(tol > 0) && !(atol > 0)) throw std::invalid_argument("tolerance and absolute tolerance are both zero");
-    if (!(safety > 0 && safety <= 1)) throw std::invalid_argument("safety factor must be in (0, 1]");
-    if (!(fac_min > 0 && fac_min < 1)) throw std::invalid_argument("fac_min must be in (0, 1)");
-    if (!(fac_max > 1 && std::isfinite(fac_max))) throw std::invalid_argument("fac_max must be a finite number > 1");
-    if (!std::isfinite(h0) || h0 < 0) throw std::invalid_argument("initial step h0 must be finite and >= 0");
-    if (!std::isfinite(h_max) || h_max < 0) throw std::invalid_argument("h_max must be finite and >= 0");
-    if (max_steps <= 0) throw std::invalid_argument("max_steps must be positive");
-    if (error_order < 0) throw std::invalid_argument("error_order must be >= 0");
-  }
-};
 
 struct AdaptiveStats {
   long accepted = 0;

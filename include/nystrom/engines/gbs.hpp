@@ -34,10 +34,9 @@
 
 #include "nystrom/core/error.hpp"
 #include "nystrom/core/state.hpp"
+#include "nystrom/engines/options.hpp"
 
 namespace nystrom {
-
-enum class GbsSequence { harmonic, romberg, bulirsch };
 
 namespace detail {
 inline std::string fmt_g(double x) {
@@ -68,15 +67,6 @@ inline std::vector<long> gbs_sequence(GbsSequence seq, int kmax) {
   }
   return n;
 }
-
-struct GbsOptions {
-  double rtol = 1e-12;
-  double atol = 1e-12;
-  int max_columns = 12;  // kmax: columns of the extrapolation table (order up to 2 kmax)
-  GbsSequence sequence = GbsSequence::harmonic;
-  double initial_step = 0;    // 0: the first call's span
-  long max_steps = 10000000;  // per integrate_to call, accepted and rejected
-};
 
 template <class V, class F>
 class GbsIntegrator {

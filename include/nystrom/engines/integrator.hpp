@@ -38,7 +38,7 @@ std::vector<S> mpe_coefficients_as(const MpeCoefficients& mc) {
   mpfr_init2(x, static_cast<mpfr_prec_t>(reference_bits(scalar_traits<T>::bits())));
   for (const auto& q : mc.c) {
     mpfr_set_q(x, q.get_mpq_t(), MPFR_RNDN);
-    c.push_back(S(scalar_traits<T>::from_mpfr(x)));
+    c.push_back(S(from_mpfr_as<T>(x)));
   }
   mpfr_clear(x);
   return c;

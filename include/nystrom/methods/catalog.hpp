@@ -17,14 +17,12 @@
 //   suzuki:P              Suzuki's 5-fold fractal composition of even order P on position Verlet
 //   suzuki-vv:P           (also suzuki-pv:P) and on velocity Verlet
 //
-// The definitions are in methods/impl/catalog.ipp: included from here (inline) in header-only builds,
-// compiled once with NYSTROM_SEPARATE_COMPILATION (core/config.hpp).
+// The definitions are compiled in libnystrom (lib/catalog.cpp).
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "nystrom/core/config.hpp"
 #include "nystrom/methods/method.hpp"
 
 namespace nystrom {
@@ -32,24 +30,20 @@ namespace nystrom {
 namespace detail {
 /// Fills the fields of MethodInfo that follow from the coefficients (stages, forces per step, FSAL,
 /// complex; clears `symplectic` for complex methods whose imaginary parts are dropped).
-NYSTROM_DECL void finalize_info(MethodDef& d);
+void finalize_info(MethodDef& d);
 }  // namespace detail
 
 /// All named methods, with derived fields filled in. Built once.
-NYSTROM_DECL const std::vector<MethodDef>& catalog();
+const std::vector<MethodDef>& catalog();
 
 /// Resolves a method specification (see the top of this file). Throws std::invalid_argument.
-NYSTROM_DECL MethodDef resolve_method(const std::string& spec);
+MethodDef resolve_method(const std::string& spec);
 
 /// Reads the method file of a "file:PATH" specification. The method-file format, which verifies a file's
 /// declared order by the BCH expansion, lives above the methods (analysis/method_file.hpp); including
 /// that header installs its reader here, so that resolving a catalog method never compiles the BCH
 /// machinery. Without a reader, resolve_method refuses "file:" specifications.
 using MethodFileReader = MethodDef (*)(const std::string& path);
-NYSTROM_DECL void set_method_file_reader(MethodFileReader reader);
+void set_method_file_reader(MethodFileReader reader);
 
 }  // namespace nystrom
-
-#ifndef NYSTROM_SEPARATE_COMPILATION
-#include "nystrom/methods/impl/catalog.ipp"
-#endif

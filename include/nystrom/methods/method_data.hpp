@@ -1,11 +1,10 @@
 // method_data_for: the coefficients of a method for a working type, refined where the published
-// digits do not suffice (methods/refine.hpp). Its definition is in methods/impl/method_data.ipp
-// (compiled once with NYSTROM_SEPARATE_COMPILATION, see core/config.hpp; inline otherwise).
+// digits do not suffice (methods/refine.hpp). Compiled in libnystrom
+// (lib/method_data.cpp).
 #pragma once
 
 #include <string>
 
-#include "nystrom/core/config.hpp"
 #include "nystrom/methods/method.hpp"
 
 namespace nystrom {
@@ -14,10 +13,6 @@ namespace nystrom {
 /// the matching reference precision (set here). Exact methods and tables with enough digits are
 /// built as they are; splitting methods published with too few digits are refined (cached per
 /// method and precision); anything else is refused with std::invalid_argument.
-NYSTROM_DECL MethodData method_data_for(const MethodDef& def, long bits, const std::string& type_name);
+MethodData method_data_for(const MethodDef& def, long bits, const std::string& type_name);
 
 }  // namespace nystrom
-
-#ifndef NYSTROM_SEPARATE_COMPILATION
-#include "nystrom/methods/impl/method_data.ipp"
-#endif

@@ -569,5 +569,5 @@ inline Refinement refine_splitting(const SplittingScheme<bigcomplex>& published,
 
 }  // namespace nystrom
 
-// method_data_for (declared there; defined in methods/impl/method_data.ipp) uses the refinement above.
+// method_data_for (declared there; defined in lib/method_data.cpp) uses the refinement above.
 #include "nystrom/methods/method_data.hpp"

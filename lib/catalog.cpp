@@ -1,8 +1,5 @@
 // Definitions of the catalog (declared in methods/catalog.hpp): every coefficient table, the registry and
-// the specification parser. Header-only builds include this file from catalog.hpp (inline); with
-// NYSTROM_SEPARATE_COMPILATION it is compiled once, in lib/nystrom.cpp (see core/config.hpp).
-#pragma once
-
+// the specification parser, compiled once in libnystrom.
 #include <algorithm>
 #include <atomic>
 #include <cctype>
@@ -29,7 +26,7 @@ inline bool any_complex(const std::vector<bigcomplex>& v) {
 }
 
 /// Fills the fields of MethodInfo that follow from the coefficients.
-NYSTROM_DECL void finalize_info(MethodDef& d) {
+void finalize_info(MethodDef& d) {
   BigPrecision guard(128);
   const MethodData data = d.build();
   MethodInfo& in = d.info;
@@ -70,7 +67,7 @@ inline std::string lower(std::string s) {
 }  // namespace detail
 
 /// All named methods, with derived fields filled in. Built once.
-NYSTROM_DECL const std::vector<MethodDef>& catalog() {
+const std::vector<MethodDef>& catalog() {
   static const std::vector<MethodDef> all = [] {
     std::vector<MethodDef> v;
     auto add = [&v](std::vector<MethodDef> more) {
@@ -90,15 +87,15 @@ NYSTROM_DECL const std::vector<MethodDef>& catalog() {
 
 /// Resolves a method specification (see the top of this file). Throws std::invalid_argument.
 namespace detail {
-NYSTROM_DECL std::atomic<MethodFileReader>& method_file_reader() {
+std::atomic<MethodFileReader>& method_file_reader() {
   static std::atomic<MethodFileReader> reader{nullptr};
   return reader;
 }
 }  // namespace detail
 
-NYSTROM_DECL void set_method_file_reader(MethodFileReader reader) { detail::method_file_reader().store(reader); }
+void set_method_file_reader(MethodFileReader reader) { detail::method_file_reader().store(reader); }
 
-NYSTROM_DECL MethodDef resolve_method(const std::string& spec) {
+MethodDef resolve_method(const std::string& spec) {
   if (spec.empty()) throw std::invalid_argument("empty method name");
   for (const auto& d : catalog()) {
     if (d.info.name == spec) return d;

@@ -1,7 +1,4 @@
-// Definition of method_data_for (declared in methods/method_data.hpp). Header-only builds include it
-// from there (inline); with NYSTROM_SEPARATE_COMPILATION it is compiled once, in lib/nystrom.cpp.
-#pragma once
-
+// Definition of method_data_for (declared in methods/method_data.hpp), compiled once in libnystrom.
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -12,7 +9,7 @@
 
 namespace nystrom {
 
-NYSTROM_DECL MethodData method_data_for(const MethodDef& def, long bits, const std::string& type_name) {
+MethodData method_data_for(const MethodDef& def, long bits, const std::string& type_name) {
   const unsigned ref = reference_bits(bits);
   BigPrecision guard(ref);
   MethodData data = def.build();

@@ -1,0 +1,48 @@
+// The options of the adaptive engines (the adaptive RKN and multi-product controllers, GBS): plain data,
+// light enough for the public solve() header (solve/options.hpp).
+#pragma once
+
+#include <cmath>
+#include <stdexcept>
+
+namespace nystrom {
+
+struct AdaptiveOptions {
+  double tol = 1e-10;         // relative tolerance, and the absolute one when atol is 0 (see the norm above)
+  double atol = 0;            // absolute tolerance; 0 (or equal to tol): the mixed norm with tol alone
+  double safety = 0.9;        // safety factor on the optimal step (see below)
+  double fac_min = 0.2;       // smallest step ratio per step
+  double fac_max = 4.0;       // largest step ratio per step
+  double h0 = 0.0;            // first step; 0: automatic
+  double h_max = 0.0;         // largest step; 0: |t1 - t0|
+  long max_steps = 10000000;  // accepted + rejected steps per integrate_to call
+  int error_order = 0;        // p, the lower order of the pair; 0: determined from the tableau
+  bool predictive = true;     // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
+
+  void validate() const {
+    if (!std::isfinite(tol) || !(tol >= 0)) throw std::invalid_argument("tolerance must be a finite number >= 0");
+    if (!std::isfinite(atol) || !(atol >= 0))
+      throw std::invalid_argument("absolute tolerance must be a finite number >= 0");
+    if (!(tol > 0) && !(atol > 0)) throw std::invalid_argument("tolerance and absolute tolerance are both zero");
+    if (!(safety > 0 && safety <= 1)) throw std::invalid_argument("safety factor must be in (0, 1]");
+    if (!(fac_min > 0 && fac_min < 1)) throw std::invalid_argument("fac_min must be in (0, 1)");
+    if (!(fac_max > 1 && std::isfinite(fac_max))) throw std::invalid_argument("fac_max must be a finite number > 1");
+    if (!std::isfinite(h0) || h0 < 0) throw std::invalid_argument("initial step h0 must be finite and >= 0");
+    if (!std::isfinite(h_max) || h_max < 0) throw std::invalid_argument("h_max must be finite and >= 0");
+    if (max_steps <= 0) throw std::invalid_argument("max_steps must be positive");
+    if (error_order < 0) throw std::invalid_argument("error_order must be >= 0");
+  }
+};
+
+enum class GbsSequence { harmonic, romberg, bulirsch };
+
+struct GbsOptions {
+  double rtol = 1e-12;
+  double atol = 1e-12;
+  int max_columns = 12;  // kmax: columns of the extrapolation table (order up to 2 kmax)
+  GbsSequence sequence = GbsSequence::harmonic;
+  double initial_step = 0;    // 0: the first call's span
+  long max_steps = 10000000;  // per integrate_to call, accepted and rejected
+};
+
+}  // namespace nystrom

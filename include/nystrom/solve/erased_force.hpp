@@ -1,0 +1,140 @@
+// A user's force behind one fixed interface, so that the drivers and engines of solve() are compiled once,
+// in libnystrom, for every supported scalar type, instead of once per force in every program.
+//
+// ErasedForce<T> owns a copy of the user's callable (a lambda, capturing or not, or any functor) and calls
+// it through a function pointer: force(t, q, a) on std::vector<T> states, and force(q, a) on complex
+// states when the callable accepts them (complex-coefficient methods). Copies are deep, as copies of the
+// callable itself would be: an engine that gives each thread its own force (the concurrent multi-product
+// schedule) gets its own copy of the user's functor, exactly as on the inline path.
+//
+// After every call the size of the output is checked: a force that assigns a vector of another size to `a`
+// is refused with invalid_input instead of writing past the engine's buffers.
+#pragma once
+
+#include <complex>
+#include <cstddef>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "nystrom/core/error.hpp"
+#include "nystrom/solve/problem.hpp"
+
+namespace nystrom {
+
+namespace erased_detail {
+[[noreturn]] inline void resized(std::size_t got, std::size_t want) {
+  throw invalid_input("the force changed the size of its output a from " + std::to_string(want) + " to " +
+                      std::to_string(got) + " (write a[i], do not assign a new vector)");
+}
+}  // namespace erased_detail
+
+template <class T>
+class ErasedForce {
+ public:
+  using V = std::vector<T>;
+  using VC = std::vector<std::complex<T>>;
+
+  ErasedForce() = default;
+
+  /// Wraps a copy of f, a force for states V in either form of SecondOrderProblem (force(q, a) or
+  /// force(t, q, a)); force(q, a) on complex states when f accepts them.
+  template <class F>
+  requires(!std::is_same_v<std::decay_t<F>, ErasedForce>) explicit ErasedForce(const F& f)
+      : obj_(new F(f)), ops_(&ops_for<F>) {}
+
+  ErasedForce(const ErasedForce& o) : obj_(o.ops_ ? o.ops_->clone(o.obj_) : nullptr), ops_(o.ops_) {}
+  ErasedForce(ErasedForce&& o) noexcept : obj_(std::exchange(o.obj_, nullptr)), ops_(std::exchange(o.ops_, nullptr)) {}
+  ErasedForce& operator=(ErasedForce o) noexcept {
+    std::swap(obj_, o.obj_);
+    std::swap(ops_, o.ops_);
+    return *this;
+  }
+  ~ErasedForce() {
+    if (ops_) ops_->destroy(obj_);
+  }
+
+  /// Whether the wrapped force takes the time (force(t, q, a)).
+  bool time_dependent() const { return ops_ && ops_->time_dependent; }
+  /// Whether it accepts complex states (complex-coefficient methods).
+  bool accepts_complex() const { return ops_ && ops_->complex != nullptr; }
+
+  /// a = a(t, q) (t is ignored by a time-independent force).
+  void operator()(const T& t, const V& q, V& a) {
+    const std::size_t n = a.size();
+    ops_->real(obj_, t, q, a);
+    if (a.size() != n) erased_detail::resized(a.size(), n);
+  }
+  /// a = a(q) on complex states; invalid_input when the force does not accept them.
+  void operator()(const VC& q, VC& a) {
+    if (!accepts_complex())
+      throw invalid_input(
+          "this method has complex coefficients: its force must accept complex states (a generic lambda or a "
+          "template operator()) and not depend on time");
+    const std::size_t n = a.size();
+    ops_->complex(obj_, q, a);
+    if (a.size() != n) erased_detail::resized(a.size(), n);
+  }
+
+ private:
+  struct Ops {
+    void (*real)(void*, const T&, const V&, V&);
+    void (*complex)(void*, const VC&, VC&);
+    void* (*clone)(const void*);
+    void (*destroy)(void*);
+    bool time_dependent;
+  };
+  template <class F>
+  static constexpr Ops ops_for = {[](void* p, const T& t, const V& q, V& a) {
+                                    F& f = *static_cast<F*>(p);
+                                    if constexpr (AutonomousForce<F, V>) {
+                                      (void)t;
+                                      f(q, a);
+                                    } else {
+                                      f(t, q, a);
+                                    }
+                                  },
+                                  [] {
+                                    if constexpr (AutonomousForce<F, V> && std::is_invocable_v<F&, const VC&, VC&>)
+                                      return +[](void* p, const VC& q, VC& a) { (*static_cast<F*>(p))(q, a); };
+                                    else
+                                      return static_cast<void (*)(void*, const VC&, VC&)>(nullptr);
+                                  }(),
+                                  [](const void* p) -> void* { return new F(*static_cast<const F*>(p)); },
+                                  [](void* p) { delete static_cast<F*>(p); }, !AutonomousForce<F, V>};
+
+  void* obj_ = nullptr;
+  const Ops* ops_ = nullptr;
+};
+
+/// The two forms the compiled drivers are instantiated for: a time-independent force (with its complex
+/// form), and a time-dependent one.
+template <class T>
+struct ErasedAutonomous {
+  ErasedForce<T> f;
+  void operator()(const std::vector<T>& q, std::vector<T>& a) { f(T(0), q, a); }
+  void operator()(const std::vector<std::complex<T>>& q, std::vector<std::complex<T>>& a) { f(q, a); }
+};
+template <class T>
+struct ErasedTimed {
+  ErasedForce<T> f;
+  void operator()(const T& t, const std::vector<T>& q, std::vector<T>& a) { f(t, q, a); }
+};
+
+/// A problem on std::vector<T> states with its force erased: what the compiled solve() receives.
+template <class T>
+struct ErasedProblem {
+  ErasedForce<T> force;
+  std::vector<T> q0, v0;
+  T t0{}, t1{};
+};
+
+template <class V, class F>
+ErasedProblem<typename V::value_type> erase(const SecondOrderProblem<V, F>& p) {
+  using T = typename V::value_type;
+  return {ErasedForce<T>(p.force), std::vector<T>(p.q0.begin(), p.q0.end()), std::vector<T>(p.v0.begin(), p.v0.end()),
+          p.t0, p.t1};
+}
+
+}  // namespace nystrom

@@ -1,0 +1,165 @@
+// The compiled path of solve() (libnystrom, the force behind ErasedForce) against the inline path
+// (nystrom/solve_inline.hpp, the driver compiled here for the force itself): bitwise the same results for
+// every method of the catalog, both time directions, time-dependent forces, output times, events and
+// checkpoints; the erased force's copies, size checks and errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "nystrom/methods/catalog.hpp"
+#include "nystrom/problems/kepler.hpp"
+#include "nystrom/solve/solve.hpp"
+
+using namespace nystrom;
+using Vd = std::vector<double>;
+
+namespace {
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void expect_bitwise(const Solution<Vd>& a, const Solution<Vd>& b) {
+  ASSERT_EQ(a.t.size(), b.t.size());
+  for (std::size_t i = 0; i < a.t.size(); ++i) {
+    ASSERT_TRUE(same_bits(a.t[i], b.t[i])) << "t[" << i << "]";
+    for (std::size_t j = 0; j < a.q[i].size(); ++j) {
+      ASSERT_TRUE(same_bits(a.q[i][j], b.q[i][j])) << "q[" << i << "][" << j << "]";
+      ASSERT_TRUE(same_bits(a.v[i][j], b.v[i][j])) << "v[" << i << "][" << j << "]";
+    }
+  }
+  for (std::size_t j = 0; j < a.q_final.size(); ++j) {
+    EXPECT_TRUE(same_bits(a.q_final[j], b.q_final[j]));
+    EXPECT_TRUE(same_bits(a.v_final[j], b.v_final[j]));
+  }
+  EXPECT_EQ(a.force_evals, b.force_evals);
+  EXPECT_EQ(a.output_force_evals, b.output_force_evals);
+  EXPECT_EQ(a.accepted, b.accepted);
+  EXPECT_EQ(a.rejected, b.rejected);
+  ASSERT_EQ(a.events.size(), b.events.size());
+  for (std::size_t i = 0; i < a.events.size(); ++i) EXPECT_TRUE(same_bits(a.events[i].t, b.events[i].t));
+}
+
+// Kepler e = 0.5 on std::vector<double>, a generic force (complex-coefficient methods run on it too).
+struct VecKepler {
+  template <class V>
+  void operator()(const V& q, V& a) const {
+    KeplerForce{}(q, a);
+  }
+};
+
+SecondOrderProblem<Vd, VecKepler> kepler_vec(double t0, double t1) {
+  const auto s = KeplerProblem<double>(0.5).initial_state();
+  return SecondOrderProblem(VecKepler{}, Vd{s.q[0], s.q[1]}, Vd{s.v[0], s.v[1]}, t0, t1);
+}
+
+SolveOptions options_for(const MethodDef& d) {
+  if (d.info.adaptive) return {.rtol = 1e-9};
+  return {.steps = 60};
+}
+
+}  // namespace
+
+TEST(Compiled, EveryCatalogMethodIsBitwiseTheInlinePathBothDirections) {
+  std::vector<MethodDef> methods = catalog();
+  methods.push_back(resolve_solve_method("GBS"));
+  methods.push_back(resolve_solve_method("MPE-adaptive"));
+  for (const auto& d : methods) {
+    for (const double t1 : {3.0, -3.0}) {
+      SCOPED_TRACE(d.info.name + (t1 > 0 ? " forward" : " backward"));
+      const auto prob = kepler_vec(0.0, t1);
+      const SolveOptions opt = options_for(d);
+      const auto a = solve(prob, d, opt);
+      const auto b = solve_inline(prob, d, opt);
+      expect_bitwise(a, b);
+      EXPECT_LT(std::abs(a.q_final[0]) + std::abs(a.q_final[1]), 10.0);  // a real orbit, not garbage
+    }
+  }
+}
+
+TEST(Compiled, TimeDependentForceOutputTimesEventsAndCheckpointsAreBitwiseTheInlinePath) {
+  // A driven oscillator q'' = -q + cos(2t): q(t) = (4/3) cos t - (1/3) cos 2t from q(0) = 1, v(0) = 0.
+  auto force = [](double t, const Vd& q, Vd& a) { a[0] = -q[0] + std::cos(2 * t); };
+  const SecondOrderProblem prob(force, Vd{1.0}, Vd{0.0}, 0.0, 7.0);
+  const std::vector<Event<Vd>> events = {{.name = "zero", .g = [](double, const Vd& q, const Vd&) { return q[0]; }}};
+  for (const std::string m : {"M8", "KL8", "DP12-adaptive", "M12-adaptive", "GBS"}) {
+    SCOPED_TRACE(m);
+    SolveOptions opt = m == "M8" || m == "KL8" ? SolveOptions{.steps = 300} : SolveOptions{.rtol = 1e-11};
+    opt.t_eval = {1.0, 2.5, 6.0};
+    opt.checkpoint_at = 3.0;
+    const auto a = solve(prob, m, opt, events);
+    const auto b = solve_inline(prob, m, opt, events);
+    expect_bitwise(a, b);
+    const double t = 6.0, exact = 4.0 / 3.0 * std::cos(t) - std::cos(2 * t) / 3.0;
+    ASSERT_EQ(a.t.size(), 3u);
+    EXPECT_NEAR(a.q[2][0], exact, 1e-8);
+    EXPECT_GE(a.events.size(), 2u);
+    // The run resumed from its checkpoint is bitwise the uninterrupted one.
+    ASSERT_TRUE(a.checkpoint.has_value());
+    SolveOptions ropt = opt;
+    ropt.checkpoint_at = std::numeric_limits<double>::quiet_NaN();
+    ropt.t_eval = {6.0};
+    const auto r = resume(prob, m, *a.checkpoint, ropt, events);
+    EXPECT_TRUE(same_bits(r.q_final[0], a.q_final[0]));
+    EXPECT_TRUE(same_bits(r.v_final[0], a.v_final[0]));
+  }
+}
+
+TEST(Compiled, DenseOutputOutlivesTheCallAndTheForceCopyIsIndependent) {
+  struct Counting {
+    long* calls;
+    long own = 0;  // a copy's own count: copies must not share it
+    void operator()(const Vd& q, Vd& a) {
+      ++*calls;
+      ++own;
+      a[0] = -q[0];
+    }
+  };
+  long calls = 0;
+  SolveOptions opt{.steps = 100};
+  opt.dense = true;
+  Solution<Vd> sol;
+  {
+    const SecondOrderProblem prob(Counting{&calls}, Vd{1.0}, Vd{0.0}, 0.0, 2.0);
+    sol = solve(prob, "M8", opt);
+    EXPECT_EQ(prob.force.own, 0);  // the problem's force is copied, never called
+  }
+  EXPECT_GT(calls, 0);
+  const long before = calls;
+  const auto s = sol(1.234);  // the problem is gone; the solution keeps its own copy of the force
+  EXPECT_GT(calls, before);
+  EXPECT_NEAR(s.q[0], std::cos(1.234), 1e-10);
+  EXPECT_NEAR(s.v[0], -std::sin(1.234), 1e-10);
+}
+
+TEST(Compiled, AForceThatResizesItsOutputIsRefused) {
+  auto bad = [](const Vd& q, Vd& a) { a = Vd{-q[0]}; };  // drops the second component
+  const SecondOrderProblem prob(bad, Vd{1.0, 0.0}, Vd{0.0, 1.0}, 0.0, 1.0);
+  for (const std::string m : {"VV", "M8", "DP12-adaptive", "GBS"}) {
+    SCOPED_TRACE(m);
+    const SolveOptions opt = m == "VV" || m == "M8" ? SolveOptions{.steps = 10} : SolveOptions{.rtol = 1e-8};
+    try {
+      (void)solve(prob, m, opt);
+      ADD_FAILURE() << "not refused";
+    } catch (const invalid_input& e) {
+      EXPECT_NE(std::string(e.what()).find("changed the size of its output"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Compiled, ErrorsAreNystromErrors) {
+  const auto prob = kepler_vec(0.0, 1.0);
+  EXPECT_THROW((void)solve(prob, "M99x", {.steps = 10}), invalid_input);
+  EXPECT_THROW((void)solve(prob, "DP12-adaptive", {.rtol = 1e-9, .max_steps = 0}), invalid_input);
+  // A complex-coefficient method on a force that takes only real states.
+  auto real_only = [](const Vd& q, Vd& a) { a[0] = -q[0]; };
+  const SecondOrderProblem p2(real_only, Vd{1.0}, Vd{0.0}, 0.0, 1.0);
+  try {
+    (void)solve(p2, "BC1", {.steps = 10});
+    ADD_FAILURE() << "not refused";
+  } catch (const invalid_input& e) {
+    EXPECT_NE(std::string(e.what()).find("complex states"), std::string::npos) << e.what();
+  }
+}
