@@ -1,4 +1,4 @@
-// Per-step cost of the fixed-step methods of `nystrom bench-peers` (bench/peers/peers.hpp): nystrom's
+// Per-step cost of the fixed-step methods of `nystrom bench-peers` (src/experiments/peers.hpp): nystrom's
 // VV, M4, M6, M6-5F, A6, M8, KL8, M10, SS10, M12, DP12 (compensated summation on, the default for
 // double, and off for VV, M8 and DP12) and Boost.Odeint's velocity_verlet, symplectic_rkn_sb3a_mclachlan,
 // symplectic_rkn_sb3a_m4_mclachlan and runge_kutta_fehlberg78, all with the same counting Kepler force.
@@ -10,7 +10,7 @@
 //   bench_peers --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
-#include "peers/peers.hpp"
+#include "experiments/peers.hpp"
 
 namespace {
 

@@ -3,7 +3,7 @@
 // after N periods against force evaluations and wall time), with, for each target error 1e-6, 1e-9, 1e-12
 // and 1e-13, the fastest run of each library and the ratio odeint time / nystrom time (from the sweeps, then
 // from the two runs re-timed alternately); and the round-off floor of M8, SS10, DP12 and M12-adaptive
-// with compensated summation on and off. See bench/peers/peers.hpp.
+// with compensated summation on and off. See src/experiments/peers.hpp.
 //
 // Files in DIR: peers_runs.csv (every run), peers.json (runs and summaries), and per eccentricity E
 // peers_forces_eE.png and peers_time_eE.png (gnuplot).
@@ -17,7 +17,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include "../bench/peers/peers.hpp"
+#include "experiments/peers.hpp"
 #include "cli.hpp"
 
 namespace {

@@ -1,13 +1,13 @@
 // `nystrom cputime --n 10000 --methods Chambers,Y4,RKNb6,RKNa14,BR1,AC1 [--steps 3] [--repeats 3] [--csv FILE]`:
 // time per step of each method on an N-body system, normalised to the leapfrog measured in the same run
-// (the Gürkan paper's Table 5.1). See include/nystrom/experiments/localerr.hpp.
+// (the Gürkan paper's Table 5.1). See src/experiments/localerr.hpp.
 #include <iostream>
 #include <memory>
 
 #include <fmt/core.h>
 
 #include "cli.hpp"
-#include "nystrom/experiments/localerr.hpp"
+#include "experiments/localerr.hpp"
 
 namespace {
 

@@ -19,7 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
-#include "nystrom/analysis/discover.hpp"
+#include "experiments/discover.hpp"
 #include "nystrom/analysis/method_file.hpp"
 #include "nystrom/methods/catalog.hpp"
 

@@ -1,6 +1,6 @@
 // `nystrom localerr --problem nbody --n 400 --methods LF,Y4,RKNb6,RKNa14,BR1,AC1,Chambers --h 0.001:0.1:8
 //                   [--csv FILE] [--plot FILE.png]`: the local-error statistics of the Gürkan paper, sec. 5
-// (Figs. 5.1 and 5.2). See include/nystrom/experiments/localerr.hpp for the procedure.
+// (Figs. 5.1 and 5.2). See src/experiments/localerr.hpp for the procedure.
 #include <algorithm>
 #include <iostream>
 #include <memory>
@@ -8,7 +8,7 @@
 #include <fmt/core.h>
 
 #include "cli.hpp"
-#include "nystrom/experiments/localerr.hpp"
+#include "experiments/localerr.hpp"
 
 namespace {
 

@@ -4,7 +4,7 @@
 //   gurkan-fig5.2    the same for the 400-body Plummer sphere;
 //   gurkan-table5.1  CPU time per step normalised to the leapfrog, 10 000 bodies;
 //   gurkan-fig5.3    error against CPU time (Fig. 5.2's errors, Table 5.1's costs).
-// The measurements are the library's (include/nystrom/experiments/localerr.hpp: run_localerr, run_cputime),
+// The measurements are the library's (src/experiments/localerr.hpp: run_localerr, run_cputime),
 // the same as `nystrom localerr` and `nystrom cputime`; this file chooses the paper's settings and compares.
 #include <algorithm>
 #include <cmath>
@@ -15,7 +15,7 @@
 #include <fmt/core.h>
 
 #include "cli.hpp"
-#include "nystrom/experiments/localerr.hpp"
+#include "experiments/localerr.hpp"
 #include "reproduce.hpp"
 
 namespace nystrom::cli::reproduce {

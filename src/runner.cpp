@@ -11,7 +11,7 @@
 
 #include "cli.hpp"
 #include "nystrom/core/precision.hpp"
-#include "nystrom/experiments/nbody_run.hpp"
+#include "experiments/nbody_run.hpp"
 #include "nystrom/methods/catalog.hpp"
 
 namespace nystrom::cli {

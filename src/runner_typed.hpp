@@ -12,7 +12,7 @@
 #include "cli.hpp"
 #include "nystrom/core/precision.hpp"
 #include "nystrom/engines/integrator.hpp"
-#include "nystrom/experiments/kepler.hpp"
+#include "experiments/kepler.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "runner.hpp"

@@ -1,4 +1,4 @@
-// The order-condition search (include/nystrom/analysis/discover.hpp):
+// The order-condition search (src/experiments/discover.hpp):
 //   * the fifth-order conditions (2.4) of the Gürkan paper vanish on its published methods and agree with the
 //     BCH analysis;
 //   * a small seeded random-start search rediscovers AR1 and AC1 (polished to 30+ digits, classified);
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "nystrom/analysis/discover.hpp"
+#include "experiments/discover.hpp"
 #include "nystrom/methods/catalog.hpp"
 
 using namespace nystrom;

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "nystrom/experiments/localerr.hpp"
-#include "nystrom/experiments/nbody_run.hpp"
+#include "experiments/localerr.hpp"
+#include "experiments/nbody_run.hpp"
 
 using namespace nystrom;
 

@@ -55,6 +55,7 @@
 #include <vector>
 
 #include "nystrom/methods/refine.hpp"
+#include "experiments/kepler.hpp"
 #include "nystrom/nystrom.hpp"
 
 using namespace nystrom;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/kepler.hpp"
 #include "nystrom/nystrom.hpp"
 
 using namespace nystrom;

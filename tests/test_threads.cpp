@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "experiments/kepler.hpp"
 #include "nystrom/nystrom.hpp"
 
 using namespace nystrom;

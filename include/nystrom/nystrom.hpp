@@ -9,7 +9,6 @@
 #include "nystrom/engines/mpe.hpp"
 #include "nystrom/engines/rkn.hpp"
 #include "nystrom/engines/splitting.hpp"
-#include "nystrom/experiments/kepler.hpp"
 #include "nystrom/methods/blanes_moan2002.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/chin2010.hpp"

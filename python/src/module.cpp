@@ -21,7 +21,7 @@
 #include "nystrom/analysis/bch_report.hpp"
 #include "nystrom/analysis/method_file.hpp"
 #include "nystrom/engines/mpe.hpp"
-#include "nystrom/experiments/kepler.hpp"
+#include "experiments/kepler.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/plummer.hpp"
 #include "solve_binding.hpp"

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "nystrom/engines/gbs.hpp"
-#include "nystrom/experiments/localerr.hpp"
+#include "localerr.hpp"
 #include "nystrom/problems/kepler.hpp"
 
 namespace nystrom {
