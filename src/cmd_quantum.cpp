@@ -1,11 +1,14 @@
-// `nystrom quantum --potential harmonic --dims 1 --grid 256 --box 20 --method M8 --dt 0.05 --steps 200
-//  [--imaginary-time] [--x0 1] [--p0 0] [--g 0] [--precision double|long-double] [--json] [--plot FILE.png]`
+// `nystrom quantum --potential harmonic --dims 1 --grid 256 --box 20 [--method KL8] --dt 0.05 --steps 200
+//  [--imaginary-time [--converge TOL]] [--x0 1] [--p0 0] [--initial-file FILE] [--g 0]
+//  [--precision double|long-double] [--json] [--plot FILE.png]`
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <complex>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -38,11 +41,15 @@ struct Options {
   int dims = 1;
   int grid = 256;
   std::string box = "20";
-  std::string method = "M8";
+  std::string method;  // empty: default_method() (KL8 in real time, M8 in imaginary time)
   std::string dt = "0.05";
   long steps = 200;
   bool imaginary = false;
-  std::string x0 = "1", p0 = "0", g = "0", width = "1";
+  bool allow_negative = false;
+  std::string converge;
+  std::string initial_file;
+  std::string x0, p0, width;  // empty: not given (the Gaussian's defaults 1, 0 and 1)
+  std::string g = "0";
   std::string precision = "double";
   int threads = 1;
   bool json = false;
@@ -89,12 +96,36 @@ class MpiSession {
   int rank_ = 0, size_ = 1;
 };
 
+/// The text of a regular file of at most max_bytes bytes (a directory, a FIFO or a device is refused: reading
+/// one could block or never end).
+std::string read_bounded(const std::string& path, const std::string& flag, std::uintmax_t max_bytes) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (path.empty() || ec || !std::filesystem::exists(st)) throw UsageError("cannot read " + flag + " '" + path + "'");
+  if (!std::filesystem::is_regular_file(st))
+    throw UsageError("cannot read " + flag + " '" + path + "': not a regular file");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw UsageError("cannot read " + flag + " '" + path + "'");
+  if (size > max_bytes)
+    throw UsageError(flag + " '" + path + "' has " + std::to_string(size) + " bytes, more than the " +
+                     std::to_string(max_bytes) + " this grid allows");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UsageError("cannot read " + flag + " '" + path + "'");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (in.bad() || static_cast<std::uintmax_t>(in.gcount()) != size)
+    throw UsageError("cannot read " + flag + " '" + path + "'");
+  return text;
+}
+
+/// The most bytes a file of values for `points` grid points may have: 128 per point (two numbers of 17
+/// digits and a comment fit) and 1 MiB more.
+std::uintmax_t file_bound(std::size_t points) { return 128 * static_cast<std::uintmax_t>(points) + (1u << 20); }
+
 /// The potential's values from a text file: numbers separated by white space, `#` to the end of a line a
 /// comment, one per grid point in row-major order (last axis fastest), at x_i = -L/2 + i L/n.
 std::vector<double> read_potential_file(const std::string& path, std::size_t points) {
-  std::ifstream in(path);
-  if (path.empty() || std::filesystem::is_directory(path) || !in)
-    throw UsageError("cannot read --potential-file '" + path + "'");
+  std::istringstream in(read_bounded(path, "--potential-file", file_bound(points)));
   std::vector<double> v;
   std::string line;
   for (long number = 1; std::getline(in, line); ++number) {
@@ -107,9 +138,36 @@ std::vector<double> read_potential_file(const std::string& path, std::size_t poi
       v.push_back(nystrom::cli::parse_double(w, "--potential-file value on line " + std::to_string(number)));
     }
   }
-  if (in.bad()) throw UsageError("cannot read --potential-file '" + path + "'");
   if (v.size() != points)
     throw UsageError("--potential-file '" + path + "' has " + std::to_string(v.size()) + " values for " +
+                     std::to_string(points) + " grid points");
+  return v;
+}
+
+/// The initial wave function from a text file: one grid point per line in row-major order (last axis fastest,
+/// the order of --potential-file), "re im" or "re" (imaginary part 0); `#` to the end of a line a comment, blank
+/// lines skipped.
+std::vector<std::complex<double>> read_initial_file(const std::string& path, std::size_t points) {
+  std::istringstream in(read_bounded(path, "--initial-file", file_bound(points)));
+  std::vector<std::complex<double>> v;
+  std::string line;
+  for (long number = 1; std::getline(in, line); ++number) {
+    line = line.substr(0, line.find('#'));
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string x; words >> x;) w.push_back(x);
+    if (w.empty()) continue;
+    const std::string where = "--initial-file line " + std::to_string(number);
+    if (w.size() > 2)
+      throw UsageError(where + " has " + std::to_string(w.size()) + " numbers: one grid point per line, 're im'");
+    if (v.size() == points)
+      throw UsageError("--initial-file '" + path + "' has more values than the " + std::to_string(points) +
+                       " grid points");
+    v.emplace_back(nystrom::cli::parse_double(w[0], where + ", real part"),
+                   w.size() == 2 ? nystrom::cli::parse_double(w[1], where + ", imaginary part") : 0.0);
+  }
+  if (v.size() != points)
+    throw UsageError("--initial-file '" + path + "' has " + std::to_string(v.size()) + " values for " +
                      std::to_string(points) + " grid points");
   return v;
 }
@@ -200,9 +258,19 @@ QuantumResult run(const Options& o, [[maybe_unused]] const MpiSession& mpi) {
   }
   p.g = static_cast<R>(nystrom::cli::parse_double(o.g, "--g"));
   p.time = o.imaginary ? TimeKind::imaginary : TimeKind::real;
-  for (double x : parse_vector(o.x0, "--x0", o.dims)) p.x0.push_back(static_cast<R>(x));
-  for (double x : parse_vector(o.p0, "--p0", o.dims)) p.p0.push_back(static_cast<R>(x));
-  p.width = static_cast<R>(nystrom::cli::parse_double(o.width, "--width", Bound::positive));
+  if (!o.initial_file.empty()) {
+    if (!o.x0.empty() || !o.p0.empty() || !o.width.empty())
+      throw UsageError("--initial-file replaces the Gaussian: give no --x0, --p0 or --width with it");
+    const Grid<R> grid(o.dims, o.grid, p.box);
+    for (const auto& z : read_initial_file(o.initial_file, grid.size()))
+      p.initial.emplace_back(static_cast<R>(z.real()), static_cast<R>(z.imag()));
+  } else {
+    for (double x : parse_vector(o.x0.empty() ? "1" : o.x0, "--x0", o.dims)) p.x0.push_back(static_cast<R>(x));
+    for (double x : parse_vector(o.p0.empty() ? "0" : o.p0, "--p0", o.dims)) p.p0.push_back(static_cast<R>(x));
+    p.width = static_cast<R>(nystrom::cli::parse_double(o.width.empty() ? "1" : o.width, "--width", Bound::positive));
+  }
+  if (!o.converge.empty()) p.converge = nystrom::cli::parse_double(o.converge, "--converge", Bound::positive);
+  p.allow_negative_coefficients = o.allow_negative;
   p.fft.threads = o.threads;
   const R dt = static_cast<R>(nystrom::cli::parse_double(o.dt, "--dt", Bound::positive));
   p.autocorrelation = o.autocorrelation;
@@ -222,6 +290,9 @@ nlohmann::json to_json(const Options& o, const QuantumResult& r, int ranks) {
   j["box"] = nystrom::cli::parse_double(o.box, "--box", Bound::positive);
   j["dt"] = r.dt;
   j["steps"] = r.steps;
+  j["steps_taken"] = r.steps_taken;
+  j["converged"] = o.converge.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.converged);
+  j["initial"] = o.initial_file.empty() ? "gaussian" : "file";
   j["time"] = r.time;
   j["imaginary_time"] = o.imaginary;
   j["g"] = nystrom::cli::parse_double(o.g, "--g");
@@ -258,17 +329,26 @@ nystrom::cli::Registrar reg(
       app.add_option("--dims", o->dims, "Dimensions: 1, 2 or 3")->capture_default_str();
       app.add_option("--grid", o->grid, "Grid points per axis")->capture_default_str();
       app.add_option("--box", o->box, "Box length L (the box is [-L/2, L/2) per axis)")->capture_default_str();
-      app.add_option("--method", o->method, "Splitting or MPE method (see `nystrom methods`; also mpe4:1,2,3)")
-          ->capture_default_str();
+      app.add_option("--method", o->method,
+                     "Splitting or MPE method (see `nystrom methods`; also mpe4:1,2,3); default KL8 (unitary) in "
+                     "real time, M8 in imaginary time");
       app.add_option("--dt", o->dt, "Step (real or imaginary time)")->capture_default_str();
       app.add_option("--steps", o->steps, "Number of steps")->capture_default_str();
       app.add_flag("--imaginary-time", o->imaginary, "Propagate in imaginary time (ground state), renormalising");
+      app.add_option("--converge", o->converge,
+                     "Imaginary time: stop once |dE| per unit imaginary time over a step is below this (--steps is "
+                     "then the most; JSON: converged, steps_taken)");
+      app.add_flag("--allow-negative-coefficients", o->allow_negative,
+                   "Imaginary time: run a method with backward sub-steps (negative real parts), refused otherwise");
+      app.add_option("--initial-file", o->initial_file,
+                     "Initial wave function: one grid point per line, 're im' (or 're'), row-major (last axis "
+                     "fastest), # comments; normalised on input; replaces the Gaussian (docs/quantum.md)");
       app.add_option("--states", o->states, "Imaginary time: the N lowest states by orthogonalisation (JSON: energies)")
           ->capture_default_str();
-      app.add_option("--x0", o->x0, "Initial centre: one number (first axis) or one per axis, comma-separated")
-          ->capture_default_str();
-      app.add_option("--p0", o->p0, "Initial momentum, like --x0")->capture_default_str();
-      app.add_option("--width", o->width, "Initial Gaussian width (1: harmonic coherent state)")->capture_default_str();
+      app.add_option("--x0", o->x0,
+                     "Initial centre: one number (first axis) or one per axis, comma-separated (default 1)");
+      app.add_option("--p0", o->p0, "Initial momentum, like --x0 (default 0)");
+      app.add_option("--width", o->width, "Initial Gaussian width (default 1: the harmonic coherent state)");
       app.add_option("--g", o->g, "Gross-Pitaevskii coupling g (|psi|^2 normalised to 1)")->capture_default_str();
       app.add_option("--precision", o->precision, "double or long-double")->capture_default_str();
       app.add_option("--threads", o->threads, "FFTW threads")->capture_default_str();
@@ -283,6 +363,9 @@ nystrom::cli::Registrar reg(
         if (o->threads < 1) throw UsageError("--threads must be positive");
         if (o->states < 1 || o->states > 1000) throw UsageError("--states must be between 1 and 1000");
         if (o->states > 1 && !o->imaginary) throw UsageError("--states needs --imaginary-time");
+        if (!o->converge.empty() && !o->imaginary) throw UsageError("--converge needs --imaginary-time");
+        if (!o->converge.empty() && o->states > 1) throw UsageError("--converge works with --states 1 only");
+        if (!o->converge.empty()) nystrom::cli::parse_double(o->converge, "--converge", Bound::positive);
         nystrom::cli::parse_double(o->box, "--box", Bound::positive);
         nystrom::cli::parse_double(o->dt, "--dt", Bound::positive);
         nystrom::cli::parse_double(o->g, "--g");
@@ -300,7 +383,12 @@ nystrom::cli::Registrar reg(
         fmt::print("problem        {} in {}D, {} points per axis, box {}, g = {}{}\n",
                    o->potential_file.empty() ? o->potential : "potential from file", o->dims, o->grid, o->box, o->g,
                    o->imaginary ? ", imaginary time" : "");
-        fmt::print("steps          {} of {:.6g} (time {:.6g})\n", r.steps, r.dt, r.time);
+        if (o->converge.empty())
+          fmt::print("steps          {} of {:.6g} (time {:.6g})\n", r.steps_taken, r.dt, r.time);
+        else
+          fmt::print("steps          {} of at most {}, of {:.6g} (time {:.6g}): {} (|dE/dtau| {} {})\n", r.steps_taken,
+                     r.steps, r.dt, r.time, r.converged ? "converged" : "NOT converged",
+                     r.converged ? "<" : ">=", o->converge);
         fmt::print("norm           {:.15f} (drift {:+.3e})\n", r.norm, r.norm_drift);
         fmt::print("energy         {:.15f}\n", r.energy);
         for (std::size_t n = 1; n < r.energies.size(); ++n) fmt::print("energy {:<7} {:.15f}\n", n, r.energies[n]);

@@ -2,15 +2,18 @@
 // bad input (exit code 2, one line `nystrom: error: ...`). The tool is found through NYSTROM_BIN.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -186,6 +189,135 @@ TEST(QuantumCli, BadInputExitsTwoWithOneLine) {
   }
   const auto missing = run("quantum --grid 32 --steps 2 --plot " + (dir / "no" / "such" / "f.png").string());
   EXPECT_EQ(missing.code, 2) << missing.err;
+}
+
+// Imaginary time refuses a method with a backward sub-step (Forest-Ruth on the double well printed a wrong energy,
+// 210 for 0.8696 on 128 points in a box of 8, and exited 0) with one line naming the forward methods and the override;
+// the override runs it; the forward methods run.
+TEST(QuantumCli, ImaginaryTimeRefusesBackwardMethods) {
+  const std::string args =
+      "quantum --potential double-well --grid 128 --box 8 --imaginary-time --dt 0.05 --steps 400 --json ";
+  for (const std::string m : {"FR", "KL8"}) {
+    const auto r = run(args + "--method " + m);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("nystrom: error: '" + m + "' has a coefficient with a real part that is not positive", 0), 0u)
+        << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    for (const char* alt : {"M4..M16", "Chin's 4A", "BC1", "--allow-negative-coefficients"})
+      EXPECT_NE(r.err.find(alt), std::string::npos) << alt << " not in " << r.err;
+  }
+  const auto forced = run(args + "--method FR --allow-negative-coefficients");
+  ASSERT_EQ(forced.code, 0) << forced.err;
+  double e0 = 0;
+  for (const std::string m : {"M8", "BC1"}) {
+    const auto r = run(args + "--method " + m);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const double e = nlohmann::json::parse(r.out)["energy"].get<double>();
+    if (m == "M8") e0 = e;
+    EXPECT_NEAR(e, e0, 1e-6) << m;
+  }
+  EXPECT_GT(std::abs(nlohmann::json::parse(forced.out)["energy"].get<double>() - e0), 1.0);
+}
+
+// The default method: KL8 (unitary) in real time, M8 in imaginary time, as in the library and Python.
+TEST(QuantumCli, DefaultMethodIsKL8InRealTimeAndM8InImaginaryTime) {
+  const auto real = run("quantum --potential double-well --dt 0.01 --steps 200 --json");
+  ASSERT_EQ(real.code, 0) << real.err;
+  const auto jr = nlohmann::json::parse(real.out);
+  EXPECT_EQ(jr["method"], "KL8");
+  EXPECT_NEAR(jr["norm"].get<double>(), 1, 1e-12);
+  const auto imag = run("quantum --imaginary-time --steps 10 --json");
+  ASSERT_EQ(imag.code, 0) << imag.err;
+  EXPECT_EQ(nlohmann::json::parse(imag.out)["method"], "M8");
+}
+
+// --initial-file: three times the coherent state from x0 = 1, p0 = 0.5 as "re im" lines gives the --x0 1 --p0 0.5
+// run (normalised on input); a real part alone is a real value; bad files exit 2 with one line.
+TEST(QuantumCli, InitialFileGivesTheGaussianResult) {
+  const auto dir = temp_dir();
+  const auto file = dir / "psi0.txt";
+  {
+    std::ofstream out(file);
+    out << "# three times the coherent state, 64 points, box 20\n";
+    out.precision(17);
+    for (int i = 0; i < 64; ++i) {
+      const double x = -10 + i * (20.0 / 64);
+      const std::complex<double> z =
+          3 * std::pow(std::numbers::pi, -0.25) * std::exp(std::complex<double>(-(x - 1) * (x - 1) / 2, 0.5 * x));
+      out << z.real() << " " << z.imag() << "\n";
+    }
+  }
+  const std::string args = "quantum --grid 64 --method KL8 --dt 0.05 --steps 40 --json ";
+  const auto a = run(args + "--x0 1 --p0 0.5");
+  const auto b = run(args + "--initial-file " + file.string());
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  const auto ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out);
+  EXPECT_EQ(jb["initial"], "file");
+  EXPECT_NEAR(jb["norm"].get<double>(), 1, 1e-13);
+  EXPECT_NEAR(jb["energy"].get<double>(), ja["energy"].get<double>(), 1e-12);
+  EXPECT_NEAR(jb["mean_position"][0].get<double>(), ja["mean_position"][0].get<double>(), 1e-12);
+  EXPECT_TRUE(jb["exact_error"].is_null());
+
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return (dir / name).string();
+  };
+  std::string ok, few, nan, three, zero;
+  for (int i = 0; i < 8; ++i) {
+    ok += "1 0\n";
+    zero += "0 0\n";
+  }
+  for (int i = 0; i < 7; ++i) few += "1 0\n";
+  nan = few + "nan 0\n";
+  three = few + "1 0 0\n";
+  const std::string fifo = (dir / "fifo").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto big = dir / "big.txt";
+  { std::ofstream(big) << "1 0\n"; }
+  std::filesystem::resize_file(big, std::uintmax_t(1) << 24);  // 16 MiB (sparse), beyond the bound for 8 points
+  const auto fine = run("quantum --grid 8 --steps 2 --initial-file " + write("ok.txt", ok));
+  EXPECT_EQ(fine.code, 0) << fine.err;
+  for (const std::string& f :
+       {write("few.txt", few), write("many.txt", ok + "1\n"), write("nan.txt", nan), write("three.txt", three),
+        write("word.txt", few + "x 1\n"), write("zero.txt", zero), (dir / "missing.txt").string(), dir.string(), fifo,
+        std::string("/dev/zero"), big.string()}) {
+    const auto r = run("quantum --grid 8 --steps 2 --initial-file " + f);
+    EXPECT_EQ(r.code, 2) << f << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << f << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << f << ": " << r.err;
+  }
+  const auto with_x0 = run("quantum --grid 8 --steps 2 --x0 1 --initial-file " + write("ok2.txt", ok));
+  EXPECT_EQ(with_x0.code, 2) << with_x0.err;
+  EXPECT_NE(with_x0.err.find("replaces the Gaussian"), std::string::npos) << with_x0.err;
+}
+
+// --converge: the oscillator's ground state from x0 = 0.5 (E - 1/2 = e^{-2 tau}/8, |dE/dtau| = 2 (E - 1/2)) stops
+// near tau = ln(2.5e7)/2 = 8.5, 170 steps of 0.05, with E - 1/2 below the tolerance; too few steps say so.
+TEST(QuantumCli, ConvergeStopsImaginaryTimeEarly) {
+  const std::string args = "quantum --grid 64 --imaginary-time --x0 0.5 --dt 0.05 --converge 1e-8 --json ";
+  const auto r = run(args + "--steps 10000");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["converged"], true);
+  EXPECT_EQ(j["steps"], 10000);
+  EXPECT_NEAR(j["steps_taken"].get<double>(), 170, 9);
+  EXPECT_NEAR(j["time"].get<double>(), 0.05 * j["steps_taken"].get<double>(), 1e-12);
+  EXPECT_LT(std::abs(j["energy"].get<double>() - 0.5), 1e-8);
+  const auto s = run(args + "--steps 20");
+  ASSERT_EQ(s.code, 0) << s.err;
+  const auto js = nlohmann::json::parse(s.out);
+  EXPECT_EQ(js["converged"], false);
+  EXPECT_EQ(js["steps_taken"], 20);
+  const auto text = run("quantum --grid 64 --imaginary-time --x0 0.5 --dt 0.05 --converge 1e-8 --steps 20");
+  EXPECT_NE(text.out.find("NOT converged"), std::string::npos) << text.out;
+  EXPECT_TRUE(nlohmann::json::parse(run("quantum --steps 2 --json").out)["converged"].is_null());
+  for (const std::string bad : {"--converge 1e-8", "--imaginary-time --converge 0", "--imaginary-time --converge -1",
+                                "--imaginary-time --converge nan", "--imaginary-time --converge 1e-8 --states 2"}) {
+    const auto e = run("quantum --steps 2 " + bad);
+    EXPECT_EQ(e.code, 2) << bad << ": " << e.err;
+    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << bad << ": " << e.err;
+  }
 }
 
 #ifdef NYSTROM_MPIEXEC

@@ -23,11 +23,13 @@ namespace py = pybind11;
 namespace {
 
 using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using CArray = py::array_t<std::complex<double>, py::array::c_style | py::array::forcecast>;
 
 /// The arguments of nystrom.quantum, checked by the library.
 struct QuantumRequest {
   std::string potential;
   std::optional<DArray> values;
+  std::optional<CArray> initial;
   int dims = 1, grid = 256;
   double box = 20;
   std::string method;
@@ -40,6 +42,8 @@ struct QuantumRequest {
   bool autocorrelation = false;
   long samples = 0;
   int threads = 1;
+  double converge = 0;
+  bool allow_negative = false;
   py::object progress;  // None or progress(done, total)
 };
 
@@ -60,6 +64,13 @@ py::dict run(const QuantumRequest& q) {
   p.potential = q.potential;
   if (q.values)
     for (py::ssize_t i = 0; i < q.values->size(); ++i) p.values.push_back(static_cast<R>(q.values->data()[i]));
+  if (q.initial)
+    for (py::ssize_t i = 0; i < q.initial->size(); ++i) {
+      const std::complex<double> z = q.initial->data()[i];
+      p.initial.emplace_back(static_cast<R>(z.real()), static_cast<R>(z.imag()));
+    }
+  p.converge = q.converge;
+  p.allow_negative_coefficients = q.allow_negative;
   p.g = static_cast<R>(q.g);
   p.time = q.imaginary ? quantum::TimeKind::imaginary : quantum::TimeKind::real;
   for (double x : q.x0) p.x0.push_back(static_cast<R>(x));
@@ -87,6 +98,8 @@ py::dict run(const QuantumRequest& q) {
   d["dt"] = r.dt;
   d["time"] = r.time;
   d["steps"] = r.steps;
+  d["steps_taken"] = r.steps_taken;
+  d["converged"] = r.converged;
   d["norm"] = r.norm;
   d["norm_drift"] = r.norm_drift;
   d["energy"] = r.energy;
@@ -130,14 +143,15 @@ py::dict run(const QuantumRequest& q) {
 void register_quantum(py::module_& m) {
   m.def(
       "quantum",
-      [](const std::string& potential, std::optional<DArray> values, int dims, int grid, double box,
-         const std::string& method, double dt, long steps, bool imaginary, std::vector<double> x0,
+      [](const std::string& potential, std::optional<DArray> values, std::optional<CArray> initial, int dims, int grid,
+         double box, const std::string& method, double dt, long steps, bool imaginary, std::vector<double> x0,
          std::vector<double> p0, double width, double g, int states, const std::string& precision, bool autocorrelation,
-         long samples, int threads, py::object progress) {
+         long samples, int threads, double converge, bool allow_negative, py::object progress) {
         if (threads < 1) throw std::invalid_argument("threads must be positive");
         if (samples < 0) throw std::invalid_argument("samples must not be negative");
         QuantumRequest q{potential,
                          std::move(values),
+                         std::move(initial),
                          dims,
                          grid,
                          box,
@@ -153,15 +167,18 @@ void register_quantum(py::module_& m) {
                          autocorrelation,
                          samples,
                          threads,
+                         converge,
+                         allow_negative,
                          std::move(progress)};
         if (precision == "double") return run<double>(q);
         if (precision == "long-double") return run<long double>(q);
         throw std::invalid_argument("precision must be 'double' or 'long-double', got '" + precision + "'");
       },
-      py::arg("potential"), py::arg("values"), py::arg("dims"), py::arg("grid"), py::arg("box"), py::arg("method"),
-      py::arg("dt"), py::arg("steps"), py::arg("imaginary"), py::arg("x0"), py::arg("p0"), py::arg("width"),
-      py::arg("g"), py::arg("states"), py::arg("precision"), py::arg("autocorrelation"), py::arg("samples"),
-      py::arg("threads"), py::arg("progress"),
+      py::arg("potential"), py::arg("values"), py::arg("initial"), py::arg("dims"), py::arg("grid"), py::arg("box"),
+      py::arg("method"), py::arg("dt"), py::arg("steps"), py::arg("imaginary"), py::arg("x0"), py::arg("p0"),
+      py::arg("width"), py::arg("g"), py::arg("states"), py::arg("precision"), py::arg("autocorrelation"),
+      py::arg("samples"), py::arg("threads"), py::arg("converge"), py::arg("allow_negative_coefficients"),
+      py::arg("progress"),
       "quantum::solve() (nystrom/quantum/solve.hpp) with the GIL released; nystrom.quantum wraps the result.");
 }
 

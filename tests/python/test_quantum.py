@@ -192,3 +192,84 @@ def test_ctrl_c_interrupts_a_long_propagation():
             nystrom.quantum(**dict(BIG, steps=10**7))
     finally:
         timer.cancel()
+
+
+def test_imaginary_time_refuses_backward_methods_and_names_the_forward_ones():
+    # Kahan-Li 8 on the double well (128 points, box 8) gives E0 = 212 for 0.8696, with norm 1: its negative
+    # coefficients amplify the highest wave numbers in imaginary time. The message is the library's, as in C++ and
+    # the CLI.
+    well = dict(potential="double-well", grid=128, box=8.0, imaginary_time=True, steps=400)
+    for method in ("KL8", "FR"):
+        refused = f"'{method}' has a coefficient with a real part that is not positive"
+        with pytest.raises(ValueError, match=refused) as e:
+            nystrom.quantum(method=method, **well)
+        msg = str(e.value)
+        assert "\n" not in msg
+        for alt in ("M4..M16", "mpe:", "Chin's 4A", "AC1", "BC1", "allow_negative_coefficients"):
+            assert alt in msg
+    m8 = nystrom.quantum(method="M8", **well)
+    bc1 = nystrom.quantum(method="BC1", **well)
+    assert bc1.energy == pytest.approx(m8.energy, abs=1e-8)
+    assert 0 < m8.energy < 1  # below the barrier V(0) = 1
+    forced = nystrom.quantum(method="KL8", allow_negative_coefficients=True, **well)
+    assert abs(forced.energy - m8.energy) > 1  # the wrong answer the refusal prevents
+
+
+def test_default_method_is_kl8_in_real_time_and_m8_in_imaginary_time():
+    # M8 blew up on the double well at dt = 0.01 in real time (an MPE is not unitary); KL8 keeps the norm
+    res = nystrom.quantum("double-well", dt=0.01, steps=200)
+    assert res.method == "KL8" and abs(res.norm - 1) <= 1e-12
+    with pytest.raises(RuntimeError, match="smaller step or a unitary method .*KL8"):
+        nystrom.quantum("double-well", method="M8", dt=0.01, steps=1000)
+    assert nystrom.quantum(imaginary_time=True, steps=10).method == "M8"
+
+
+def test_initial_wave_function_is_normalised_and_gives_the_gaussian_result():
+    x = -10.0 + np.arange(64) * (20.0 / 64)
+    gauss = math.pi ** -0.25 * np.exp(-(x - 1) ** 2 / 2 + 0.5j * x)
+    a = nystrom.quantum(grid=64, method="KL8", dt=0.05, steps=40, x0=1.0, p0=0.5)
+    b = nystrom.quantum(grid=64, method="KL8", dt=0.05, steps=40, psi0=3 * gauss)
+    assert b.norm == pytest.approx(1, abs=1e-13)
+    assert b.energy == pytest.approx(a.energy, abs=1e-12)
+    assert b.mean_position[0] == pytest.approx(a.mean_position[0], abs=1e-12)
+    assert math.isnan(b.exact_error)
+    # an odd start relaxes to the first excited state, E = 3/2; a real array is accepted
+    odd = nystrom.quantum(grid=64, imaginary_time=True, dt=0.1, steps=100, psi0=x * np.exp(-x * x / 3))
+    assert odd.energy == pytest.approx(1.5, abs=1e-9)
+    two = nystrom.quantum(dims=2, grid=16, box=12.0, steps=2, psi0=np.ones((16, 16), dtype=complex))
+    assert two.norm == pytest.approx(1, abs=1e-13)
+    for kwargs, match in ((dict(psi0=np.ones(63)), r"psi0 has shape \(63,\), expected \(64,\)"),
+                          (dict(psi0=np.full(64, np.nan)), "the initial wave function is not finite"),
+                          (dict(psi0=np.zeros(64)), "the initial wave function is zero"),
+                          (dict(psi0=np.ones(64), x0=1.0), "psi0 replaces the Gaussian")):
+        with pytest.raises(ValueError, match=match):
+            nystrom.quantum(grid=64, steps=2, **kwargs)
+    with pytest.raises(TypeError):
+        nystrom.quantum(grid=64, steps=2, psi0=np.array(["a"] * 64))
+
+
+def test_converge_stops_imaginary_time_at_the_ground_state():
+    # from x0 = 0.5 (coherent state, excited weight 1/8): E - 1/2 = e^(-2 tau)/8, |dE/dtau| = 2 (E - 1/2), so the
+    # criterion 1e-8 is met near tau = ln(2.5e7)/2 = 8.5, i.e. 170 steps of 0.05
+    res = nystrom.quantum(grid=64, imaginary_time=True, x0=0.5, dt=0.05, steps=10000, converge=1e-8)
+    assert res.converged is True and res.steps == 10000
+    assert abs(res.steps_taken - 170) <= 9
+    assert res.time == pytest.approx(0.05 * res.steps_taken, abs=1e-12)
+    assert abs(res.energy - 0.5) < 1e-8
+    short = nystrom.quantum(grid=64, imaginary_time=True, x0=0.5, dt=0.05, steps=20, converge=1e-8)
+    assert short.converged is False and short.steps_taken == 20
+    assert nystrom.quantum(steps=2).converged is None
+    with pytest.raises(ValueError, match="needs imaginary time"):
+        nystrom.quantum(steps=2, converge=1e-8)
+    with pytest.raises(ValueError, match="converge must be positive"):
+        nystrom.quantum(steps=2, imaginary_time=True, converge=0.0)
+
+
+def test_docstring_examples_run():
+    import doctest
+
+    import nystrom._quantum as module
+
+    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
+    assert result.attempted >= 10
+    assert result.failed == 0

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -204,6 +205,68 @@ inline FlowMethod resolve_flow_method(const std::string& spec, OperatorStructure
     return {def.info, FlowMpeDef{m->k, m->base_name, 2, m->base, mc.c}};
   }
   return {def.info, std::get<SplittingScheme<bigcomplex>>(data)};
+}
+
+/// A sub-step that runs a flow backwards: its coefficient has a real part that is not positive (or, for a
+/// gradient sub-step, the gradient coefficient has a negative real part).
+struct BackwardSubStep {
+  Flow flow;
+  std::complex<double> coefficient;
+  bool gradient = false;  // the gradient coefficient of a GradientSplitting sub-step
+};
+
+/// The first sub-step of `m` that runs a flow backwards, decided from the coefficients: the sub-steps of a
+/// splitting, the gradient coefficients of a forward gradient method, the base of a multi-product expansion
+/// (whose combination coefficients are not flows). None: every flow runs forward, as diffusion-type problems
+/// (imaginary time, heat equations) need: a backward diffusion sub-step amplifies the highest modes.
+inline std::optional<BackwardSubStep> backward_sub_step(const FlowMethod& m) {
+  auto first = [](const SplittingScheme<bigcomplex>& s) -> std::optional<BackwardSubStep> {
+    for (const auto& st : normalized(s).steps)
+      if (!(st.coef.re > 0))
+        return BackwardSubStep{st.flow, {st.coef.re.convert_to<double>(), st.coef.im.convert_to<double>()}};
+    return std::nullopt;
+  };
+  if (const auto* sp = std::get_if<SplittingScheme<bigcomplex>>(&m.data)) return first(*sp);
+  if (const auto* mp = std::get_if<FlowMpeDef>(&m.data)) return first(mp->base);
+  const auto& g = std::get<GradientSplitting>(m.data);
+  if (auto b = first(g.scheme)) return b;
+  for (const auto& w : g.gradient)
+    if (w.re < 0) return BackwardSubStep{Flow::kick, {w.re.convert_to<double>(), w.im.convert_to<double>()}, true};
+  return std::nullopt;
+}
+
+inline bool runs_forward(const FlowMethod& m) { return !backward_sub_step(m).has_value(); }
+
+/// The catalog's forward methods of order 3 and above for flows of the given structure, decided from their
+/// coefficients, as a list for messages: "multi-product M4..M16 or mpe:K1,K2,..., Chin's 4A, Gurkan's AC1, ...
+/// (complex)". `gradient`: include 4A (it needs the gradient of the potential).
+inline std::string forward_alternatives(OperatorStructure structure, bool gradient) {
+  std::vector<std::string> mpe, complex, real;
+  for (const auto& def : catalog()) {
+    if (def.info.adaptive || def.info.order < 3) continue;
+    const MethodData d = def.build();
+    if (std::holds_alternative<RknTableau<bigcomplex>>(d)) continue;
+    if (structure == OperatorStructure::general && !order_holds_for_general_operators(def.info)) continue;
+    const FlowMethod fm = std::holds_alternative<MpeDef>(d)
+                              ? FlowMethod{def.info, FlowMpeDef{{}, "", 2, std::get<MpeDef>(d).base, {}}}
+                              : FlowMethod{def.info, std::get<SplittingScheme<bigcomplex>>(d)};
+    if (!runs_forward(fm)) continue;
+    (def.info.family == "mpe" ? mpe : def.info.complex ? complex : real).push_back(def.info.name);
+  }
+  std::vector<std::string> parts;
+  if (!mpe.empty())
+    parts.push_back("multi-product " + (mpe.size() > 2 ? mpe.front() + ".." + mpe.back() : mpe.front()) +
+                    " or mpe:K1,K2,...");
+  if (gradient && structure == OperatorStructure::rkn && runs_forward(chin_forward_4a(64)))
+    parts.push_back("Chin's 4A");
+  auto join = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+    return s;
+  };
+  if (!real.empty()) parts.push_back(join(real));
+  if (!complex.empty()) parts.push_back(join(complex) + " (complex, positive real parts)");
+  return join(parts);
 }
 
 /// Any splitting or multi-product method over flows F; chosen at run time, one dispatch per integrate().
