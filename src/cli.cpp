@@ -443,8 +443,11 @@ void Progress::tick(long done) {
   std::string eta;
   if (done > 0 && done < total_)
     eta = ", ETA " + duration_text(elapsed * static_cast<double>(total_ - done) / static_cast<double>(done));
-  std::fprintf(stderr, "\r%s [%s%s] %ld/%ld, %s%s   ", label_.c_str(), std::string(filled, '#').c_str(),
-               std::string(width - filled, '-').c_str(), done, total_, duration_text(elapsed).c_str(), eta.c_str());
+  // the percentage rounded down: 100.0% only for a complete run
+  const double percent = std::floor(1000.0 * static_cast<double>(done) / static_cast<double>(total_)) / 10;
+  std::fprintf(stderr, "\r%s [%s%s] %ld/%ld (%.1f%%), %s%s   ", label_.c_str(), std::string(filled, '#').c_str(),
+               std::string(width - filled, '-').c_str(), done, total_, percent, duration_text(elapsed).c_str(),
+               eta.c_str());
   std::fflush(stderr);
   drawn_ = true;
 }

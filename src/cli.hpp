@@ -147,8 +147,9 @@ std::vector<double> parse_log_range(const std::string& text, const std::string& 
 /// Splits "a,b,c"; empty items are errors.
 std::vector<std::string> split_list(const std::string& text, const std::string& what);
 
-/// A progress line on stderr for long runs ("label [####----] 12/40, 3 s, ETA 9 s"), only when stderr is a
-/// terminal or NYSTROM_PROGRESS=1; redrawn at most ten times a second.
+/// A progress line on stderr for long runs ("label [####----] 12/40 (30.0%), 3 s, ETA 9 s"), only when stderr
+/// is a terminal or NYSTROM_PROGRESS=1; redrawn at most ten times a second. An interrupted run leaves its last
+/// line as it was drawn (the signal handler ends the process): it shows where the run stopped.
 class Progress {
  public:
   Progress(std::string label, long total);

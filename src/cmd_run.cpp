@@ -1,8 +1,11 @@
 // `nystrom run --problem kepler --ecc 0.9 --method M8 --steps-per-period 1000 --periods 10 [--json]`
+#include <cstddef>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 
 #include "cli.hpp"
 #include "nystrom/methods/catalog.hpp"
@@ -12,6 +15,52 @@
 #include "sweep.hpp"
 
 namespace {
+
+// The report of one run as a table. The step of an adaptive method is the mean accepted step (span / steps).
+void print_report(const nystrom::cli::RunReport& r, bool adaptive, long rejected = -1) {
+  fmt::print("method            {} ({}, order {})\n", r.method, r.family, r.order);
+  fmt::print("problem           {}{}\n", r.problem, r.problem == "kepler" ? fmt::format(" e = {}", r.ecc) : "");
+  fmt::print("precision         {}\n", r.precision);
+  if (!adaptive)
+    fmt::print("steps             {} (h = {:.6g})\n", r.steps, r.h);
+  else if (rejected >= 0)
+    fmt::print("steps             {} accepted, {} rejected (mean h = {:.6g})\n", r.steps, rejected, r.h);
+  else
+    fmt::print("steps             {} accepted (mean h = {:.6g})\n", r.steps, r.h);
+  fmt::print("force evaluations {}\n", r.force_evals);
+  if (r.problem == "kepler") fmt::print("precession/period {:+.6e} rad\n", r.precession_per_period);
+  if (r.problem == "nbody") fmt::print("(position error against a GBS reference run at tolerance 1e-13)\n");
+  fmt::print("energy error      {:.6e} (relative)\n", r.energy_error);
+  fmt::print("position error    {:.6e}\n", r.position_error);
+  fmt::print("time              {:.6f} s\n", r.seconds);
+}
+
+// "(x, y)" of a JSON array of numbers, each the shortest decimal that reads back to the same double.
+std::string vec_text(const nlohmann::json& a) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < a.size(); ++i) s += fmt::format("{}{}", i ? ", " : "", a[i].get<double>());
+  return s + ")";
+}
+
+// What a run through solve() adds to the table: the final state, output times, events, checkpoint.
+void print_solve_extra(const nlohmann::json& x) {
+  fmt::print("output forces     {} (force evaluations of the partial steps for output times and events)\n",
+             x.at("output_force_evals").get<long>());
+  fmt::print("final state       t = {}, q = {}, v = {}\n", x.at("t").get<double>(), vec_text(x.at("q")),
+             vec_text(x.at("v")));
+  if (x.contains("checkpoint_t")) fmt::print("checkpoint        at t = {}\n", x["checkpoint_t"].get<double>());
+  if (x.contains("output")) {
+    fmt::print("output times      {}\n", x["output"].size());
+    for (const auto& o : x["output"])
+      fmt::print("  t = {}  q = {}  v = {}\n", o["t"].get<double>(), vec_text(o["q"]), vec_text(o["v"]));
+  }
+  if (x.contains("events")) {
+    fmt::print("events            {}\n", x["events"].size());
+    for (const auto& e : x["events"])
+      fmt::print("  {:<10}  t = {}  q = {}  v = {}\n", e["name"].get<std::string>(), e["t"].get<double>(),
+                 vec_text(e["q"]), vec_text(e["v"]));
+  }
+}
 
 struct Options {
   nystrom::cli::RunRequest req;
@@ -63,9 +112,10 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
       ->check(nystrom::cli::tolerance_check());
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
   app.add_option("--output-times", o->sreq.output_times,
-                 "Kepler: A:B:N, the state at N equally spaced times from A to B (dense output; JSON `output`)");
+                 "Kepler: A:B:N, the state at N equally spaced times from A to B (listed after the table; JSON "
+                 "`output`)");
   app.add_option("--events", o->sreq.events,
-                 "Kepler: events to locate, any of pericentre,apocentre,y=0 (JSON `events`)");
+                 "Kepler: events to locate, any of pericentre,apocentre,y=0 (listed after the table; JSON `events`)");
   app.add_option("--checkpoint", o->sreq.checkpoint, "Kepler: write the integrator's state to this file ...");
   app.add_option("--checkpoint-at", o->sreq.checkpoint_at, "... at the first step boundary at or after this time");
   app.add_option("--restart", o->sreq.restart,
@@ -94,29 +144,29 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
     }
     const auto def = nystrom::cli::resolve_run_method(o->method);
     nystrom::cli::check_work_budget(nystrom::cli::run_work_units(o->req, def), "run");
+    const bool adaptive = def.info.adaptive;  // GBS too: its h is then the mean accepted step
     if (o->sreq.any()) {
       const auto r = nystrom::cli::run_kepler_solve(o->req, o->sreq, def);
-      auto j = r.report.to_json();
-      for (const auto& [k, v] : r.extra.items()) j[k] = v;
-      std::cout << j.dump(2) << "\n";  // with or without --json: output times and events do not fit the table
+      if (o->json) {
+        auto j = r.report.to_json();
+        j["adaptive"] = adaptive;
+        for (const auto& [k, v] : r.extra.items()) j[k] = v;
+        std::cout << j.dump(2) << "\n";
+      } else {
+        print_report(r.report, adaptive, adaptive ? r.extra.at("rejected").get<long>() : -1);
+        print_solve_extra(r.extra);
+      }
       return 0;
     }
     o->req.progress = true;  // on a terminal, for a run that lasts more than a second
     const auto r = nystrom::cli::run_case(o->req, def);
     if (o->json) {
-      std::cout << r.to_json().dump(2) << "\n";
+      auto j = r.to_json();
+      j["adaptive"] = adaptive;
+      std::cout << j.dump(2) << "\n";
       return 0;
     }
-    fmt::print("method            {} ({}, order {})\n", r.method, r.family, r.order);
-    fmt::print("problem           {}{}\n", r.problem, r.problem == "kepler" ? fmt::format(" e = {}", r.ecc) : "");
-    fmt::print("precision         {}\n", r.precision);
-    fmt::print("steps             {} (h = {:.6g})\n", r.steps, r.h);
-    fmt::print("force evaluations {}\n", r.force_evals);
-    if (r.problem == "kepler") fmt::print("precession/period {:+.6e} rad\n", r.precession_per_period);
-    if (r.problem == "nbody") fmt::print("(position error against a GBS reference run at tolerance 1e-13)\n");
-    fmt::print("energy error      {:.6e} (relative)\n", r.energy_error);
-    fmt::print("position error    {:.6e}\n", r.position_error);
-    fmt::print("time              {:.6f} s\n", r.seconds);
+    print_report(r, adaptive);
     return 0;
   };
 });

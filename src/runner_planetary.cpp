@@ -206,6 +206,7 @@ nlohmann::json run_planetary(const PlanetaryRequest& req) {
                    {"order", o.order},
                    {"precision", req.precision},
                    {"h", num(req.h)},
+                   {"adaptive", !map && direct.info.adaptive},  // then h sets only the span: steps * h days
                    {"years", num(req.years)},
                    {"steps", o.steps},
                    {"force_evals", o.force_evals},
@@ -241,7 +242,13 @@ void print_planetary(const nlohmann::json& r) {
              r["family"].get<std::string>(), r["order"].get<int>());
   fmt::print("problem                outer solar system (Hairer, Lubich & Wanner, GNI sec. I.2.4)\n");
   fmt::print("precision              {}\n", r["precision"].get<std::string>());
-  fmt::print("steps                  {} (h = {:.6g} days, {:.6g} years)\n", r["steps"].get<long>(), d("h"), d("years"));
+  const long steps = r["steps"].get<long>();
+  if (r.value("adaptive", false))  // the span is a whole number of --h days
+    fmt::print("steps                  {} (mean h = {:.6g} days, {:.6g} years)\n", steps,
+               d("h") * std::round(d("years") * kDaysPerYear / d("h")) / static_cast<double>(steps > 0 ? steps : 1),
+               d("years"));
+  else
+    fmt::print("steps                  {} (h = {:.6g} days, {:.6g} years)\n", steps, d("h"), d("years"));
   fmt::print("force evaluations      {}\n", r["force_evals"].get<long>());
   fmt::print("energy error           {:.6e} (relative; largest over the run {:.6e})\n", d("energy_error"),
              d("energy_error_max"));

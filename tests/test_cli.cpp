@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -154,6 +155,27 @@ TEST(Cli, NBodyTwoBodyAndGbsRuns) {
   const auto g = run("run --problem kepler --ecc 0.5 --method GBS --tol 1e-12 --json");
   ASSERT_EQ(g.code, 0) << g.err;
   EXPECT_LT(nlohmann::json::parse(g.out)["position_error"].get<double>(), 1e-9);
+}
+
+TEST(Cli, OuterSolarSystemLabelsTheMeanStepOfAnAdaptiveMethod) {
+  // An adaptive direct method: --h sets only the span (a whole number of --h days); the table gives the mean
+  // accepted step and says so. A fixed-step one gives its step.
+  const auto a = run("run --problem outer-solar-system --method DP12-adaptive --tol 1e-10 --years 100 --no-reference");
+  ASSERT_EQ(a.code, 0) << a.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(a.out, m, std::regex(R"(\nsteps +(\d+) \(mean h = (\S+) days, 100 years\)\n)")))
+      << a.out;
+  const double steps = std::stod(m[1]), h = std::stod(m[2]);
+  EXPECT_NEAR(h, 36500 / steps, 1e-5 * h);
+  EXPECT_NE(h, 100.0);
+  EXPECT_EQ(nlohmann::json::parse(run("run --problem outer-solar-system --method DP12-adaptive --tol 1e-10 --years 100 "
+                                      "--no-reference --json")
+                                      .out)
+                .at("adaptive"),
+            true);
+  const auto f = run("run --problem outer-solar-system --method M8 --h 200 --years 100 --no-reference");
+  ASSERT_EQ(f.code, 0) << f.err;
+  EXPECT_NE(f.out.find("\nsteps                  183 (h = 200 days, 100 years)\n"), std::string::npos) << f.out;
 }
 
 TEST(Cli, KeepComplexHasTheOrderOfTheRealPart) {

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -480,6 +481,17 @@ TEST(CliHostile, SigintStopsALongRunWithProgressAndLeavesNoFile) {
   const std::string last = "nystrom: error: interrupted\n";
   ASSERT_GE(err.size(), last.size());
   EXPECT_EQ(err.substr(err.size() - last.size()), last);
+  // The last progress line, just before the message, shows where the run stopped: far from its end.
+  const std::string lines = err.substr(0, err.size() - last.size());
+  const std::string final_line = lines.substr(lines.rfind('\r') + 1);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(final_line, m, std::regex(R"(^run \[#*-+\] (\d+)/(\d+) \(([0-9.]+)%\), )")))
+      << final_line;
+  const double done = std::stod(m[1]), total = std::stod(m[2]), percent = std::stod(m[3]);
+  EXPECT_GT(done, 0);
+  EXPECT_LT(done, 0.5 * total);
+  EXPECT_LT(percent, 50);
+  EXPECT_NEAR(percent, 100 * done / total, 0.1);
   EXPECT_EQ(slurp(dir / "stdout.txt"), "");
   EXPECT_EQ(listing(dir / "run"), std::set<std::string>{});
   EXPECT_EQ(listing(dir / "tmp"), std::set<std::string>{});

@@ -1,5 +1,6 @@
 // The command-line contract of `run` through solve(): --output-times (dense output), --events, and
-// --checkpoint/--restart (bitwise the same end). The tool is found through NYSTROM_BIN (set by CTest).
+// --checkpoint/--restart (bitwise the same end), in text as in JSON; the step of an adaptive method is
+// labelled as a mean. The tool is found through NYSTROM_BIN (set by CTest).
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -11,8 +12,10 @@
 #include <fstream>
 #include <limits>
 #include <numbers>
+#include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -100,6 +103,78 @@ TEST(CliSolve, PericentreApocentreAndAxisCrossingEvents) {
           "pericentre --json");
   ASSERT_EQ(only.code, 0) << only.err;
   EXPECT_EQ(nlohmann::json::parse(only.out).at("events").size(), 3u);
+}
+
+TEST(CliSolve, EventsAndOutputTimesKeepTheChosenOutputFormat) {
+  const std::string args =
+      "run --problem kepler --ecc 0.9 --method DP12-adaptive --tol 1e-12 --periods 3 --events pericentre";
+  const auto text = run(args);
+  const auto json = run(args + " --json");
+  ASSERT_EQ(text.code, 0) << text.err;
+  ASSERT_EQ(json.code, 0) << json.err;
+  // Without --json: the table, then the events, one per line; no JSON.
+  EXPECT_FALSE(nlohmann::json::accept(text.out)) << text.out;
+  EXPECT_NE(text.out.find("method            DP12-adaptive"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("position error"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("events            3\n"), std::string::npos) << text.out;
+  const std::regex line(R"(\n  pericentre +t = (\S+)  q = \((\S+), (\S+)\)  v = \((\S+), (\S+)\))");
+  std::vector<std::vector<double>> listed;
+  for (std::sregex_iterator it(text.out.begin(), text.out.end(), line), end; it != end; ++it)
+    listed.push_back(
+        {std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]), std::stod((*it)[4]), std::stod((*it)[5])});
+  // With --json: the same events, the same numbers to the last bit.
+  const auto j = nlohmann::json::parse(json.out);
+  const auto& ev = j.at("events");
+  ASSERT_EQ(ev.size(), 3u);
+  ASSERT_EQ(listed.size(), 3u) << text.out;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(ev[i]["name"], "pericentre");
+    EXPECT_EQ(listed[i][0], ev[i]["t"].get<double>());
+    EXPECT_EQ(listed[i][1], ev[i]["q"][0].get<double>());
+    EXPECT_EQ(listed[i][2], ev[i]["q"][1].get<double>());
+    EXPECT_EQ(listed[i][3], ev[i]["v"][0].get<double>());
+    EXPECT_EQ(listed[i][4], ev[i]["v"][1].get<double>());
+    EXPECT_NEAR(listed[i][0], (2 * static_cast<double>(i) + 1) * pi, 1e-9);
+  }
+  EXPECT_EQ(j.at("adaptive"), true);
+  // Output times in text too: one line per time.
+  const auto times =
+      run("run --problem kepler --ecc 0.5 --method M8 --steps-per-period 200 --periods 2 --output-times 0:12:4");
+  ASSERT_EQ(times.code, 0) << times.err;
+  EXPECT_FALSE(nlohmann::json::accept(times.out)) << times.out;
+  EXPECT_NE(times.out.find("output times      4\n  t = 0  q = (1.5, 0)"), std::string::npos) << times.out;
+  EXPECT_NE(times.out.find("\n  t = 12  q = ("), std::string::npos) << times.out;
+  EXPECT_NE(times.out.find("steps             400 (h = 0.0314159)"), std::string::npos) << times.out;
+}
+
+TEST(CliSolve, AdaptiveStepIsLabelledAsAMean) {
+  // The table of an adaptive run gives the mean accepted step (span / steps), and says so; a fixed-step run
+  // gives its step. JSON says which (`adaptive`).
+  const std::regex mean(R"(\nsteps +(\d+) accepted(?:, \d+ rejected)? \(mean h = (\S+)\)\n)");
+  for (const std::string m :
+       {"--method DP12-adaptive --tol 1e-10", "--method GBS --tol 1e-10", "--method M10-adaptive --tol 1e-10"})
+    for (const std::string extra : {"", " --events apocentre"}) {
+      SCOPED_TRACE(m + extra);
+      const auto r = run("run --problem kepler --ecc 0.5 --periods 2 " + m + extra);
+      ASSERT_EQ(r.code, 0) << r.err;
+      std::smatch s;
+      ASSERT_TRUE(std::regex_search(r.out, s, mean)) << r.out;
+      const double steps = std::stod(s[1]), h = std::stod(s[2]);
+      EXPECT_GT(steps, 10);
+      EXPECT_NEAR(h, 4 * pi / steps, 1e-5 * h);
+      EXPECT_EQ(r.out.find("(h = "), std::string::npos) << r.out;
+      const auto j =
+          nlohmann::json::parse(run("run --problem kepler --ecc 0.5 --periods 2 " + m + extra + " --json").out);
+      EXPECT_EQ(j.at("adaptive"), true);
+      EXPECT_EQ(j.at("steps").get<double>(), steps);
+    }
+  const auto fixed = run("run --problem kepler --ecc 0.5 --periods 2 --method M8 --steps-per-period 100");
+  ASSERT_EQ(fixed.code, 0) << fixed.err;
+  EXPECT_NE(fixed.out.find("\nsteps             200 (h = 0.0628319)\n"), std::string::npos) << fixed.out;
+  EXPECT_EQ(fixed.out.find("mean"), std::string::npos) << fixed.out;
+  const auto jf = nlohmann::json::parse(
+      run("run --problem kepler --ecc 0.5 --periods 2 --method M8 --steps-per-period 100 --json").out);
+  EXPECT_EQ(jf.at("adaptive"), false);
 }
 
 TEST(CliSolve, RestartFromACheckpointEndsInBitwiseTheSameState) {

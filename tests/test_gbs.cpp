@@ -1,15 +1,21 @@
 // The Gragg-Bulirsch-Stoer reference integrator: convergence to the analytic Kepler solution at its
-// tolerance, in double and long double, every step-size sequence, the N-body two-body problem, bad input.
+// tolerance, in double and long double, every step-size sequence, the N-body two-body problem, bad input;
+// a time-dependent force sees only times within the span, forward and backward, through the engine and
+// through solve().
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/problems/nbody.hpp"
+#include "nystrom/solve/solve.hpp"
 
 using namespace nystrom;
 
@@ -166,4 +172,98 @@ TEST(Gbs, RejectsBadOptionsAndStopsOnASingularity) {
   State<std::vector<double>> c{{-1, 1, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}};
   GbsIntegrator<std::vector<double>, NBodyForce<double>> gc(f, o);
   EXPECT_THROW(gc.integrate_to(c, 10.0), step_size_underflow);
+}
+
+namespace {
+
+// The driven oscillator q'' = -q + cos 2t from (q0, v0) at t0: q + cos(2t)/3 is a harmonic oscillation.
+double driven_exact(double t0, double q0, double v0, double t) {
+  const double p0 = q0 + std::cos(2 * t0) / 3, dp0 = v0 - 2 * std::sin(2 * t0) / 3;
+  return p0 * std::cos(t - t0) + dp0 * std::sin(t - t0) - std::cos(2 * t) / 3;
+}
+
+// The times a time-dependent force was called at, against the span [lo, hi].
+struct TimeRange {
+  double lo, hi;
+  long outside = 0, calls = 0;
+  double worst = 0;  // farthest distance outside
+  void see(double t) {
+    ++calls;
+    if (t < lo || t > hi) {
+      ++outside;
+      worst = std::max(worst, std::max(lo - t, t - hi));
+    }
+  }
+};
+
+}  // namespace
+
+TEST(Gbs, ClockCoordinateStaysWithinTheSpanForwardAndBackward) {
+  // The engine on (x, tau) with tau the time coordinate (velocity 1, acceleration 0); backward in time as
+  // solve() runs it: tau = -t on the time-reversed problem (v -> -v).
+  using V = std::array<double, 2>;
+  const double t0 = 0.3;
+  for (double len : {40.0, -40.0, 0.37})
+    for (double tol : {1e-10, 1e-13}) {
+      SCOPED_TRACE("span " + std::to_string(len) + ", tol " + std::to_string(tol));
+      const double t1 = t0 + len, dir = len > 0 ? 1 : -1;
+      TimeRange seen{std::min(t0, t1), std::max(t0, t1)};
+      auto force = [&](const V& q, V& a) {
+        const double t = dir * q[1];
+        seen.see(t);
+        a[0] = -q[0] + std::cos(2 * t);
+        a[1] = 0;
+      };
+      GbsOptions o;
+      o.rtol = o.atol = tol;
+      GbsIntegrator<V, decltype(force)> g(force, o);
+      g.set_clock(1, dir * t1);
+      State<V> s{{1.0, dir * t0}, {dir * 0.5, 1.0}};
+      g.integrate_to(s, std::abs(len));
+      EXPECT_EQ(seen.outside, 0) << "farthest outside by " << seen.worst;
+      EXPECT_GT(seen.calls, 10);
+      // the clock ends on t1 (up to the rounding of t0 + span) and moved at velocity 1 exactly
+      EXPECT_LE(s.q[1], dir * t1);
+      EXPECT_NEAR(dir * s.q[1], t1, 4 * std::numeric_limits<double>::epsilon() * std::abs(t1));
+      EXPECT_EQ(s.v[1], 1.0);
+      EXPECT_NEAR(s.q[0], driven_exact(t0, 1.0, 0.5, t1), 200 * tol);
+    }
+  // A clock outside the state is refused.
+  auto none = [](const V&, V& a) { a = {0, 0}; };
+  GbsIntegrator<V, decltype(none)> g(none);
+  g.set_clock(2, 1.0);
+  State<V> s{{0, 0}, {0, 1}};
+  EXPECT_THROW(g.integrate_to(s, 1.0), std::invalid_argument);
+}
+
+TEST(Gbs, TimeDependentForceThroughSolveSeesOnlyTimesWithinTheSpan) {
+  // A force built on a table over [t0, t1] (an ephemeris) fails outside it: GBS through solve() never asks
+  // there, forward and backward, with output times, events (partial steps) and dense output.
+  using V = std::vector<double>;
+  const double t0 = 0.3;
+  for (double len : {40.0, -40.0})
+    for (double tol : {1e-10, 1e-13}) {
+      SCOPED_TRACE("span " + std::to_string(len) + ", tol " + std::to_string(tol));
+      const double t1 = t0 + len;
+      TimeRange seen{std::min(t0, t1), std::max(t0, t1)};
+      auto force = [&seen](const double& t, const V& q, V& a) {
+        seen.see(t);
+        a[0] = -q[0] + std::cos(2 * t);
+      };
+      const auto prob = SecondOrderProblem(force, V{1.0}, V{0.5}, t0, t1);
+      SolveOptions opt;
+      opt.rtol = tol;
+      for (int i = 1; i <= 7; ++i) opt.t_eval.push_back(t0 + len * i / 7);
+      const std::vector<Event<V>> events = {{"q=0", [](const double&, const V& q, const V&) { return q[0]; }}};
+      const auto sol = solve(prob, "GBS", opt, events);
+      ASSERT_EQ(sol.status, SolveStatus::success) << sol.message;
+      EXPECT_GT(sol.events.size(), 5u);
+      const auto mid = sol(t0 + len * 0.123);  // dense output: a partial step after the run
+      EXPECT_EQ(seen.outside, 0) << "farthest outside by " << seen.worst;
+      ASSERT_EQ(sol.t.size(), opt.t_eval.size());
+      for (std::size_t i = 0; i < sol.t.size(); ++i)
+        EXPECT_NEAR(sol.q[i][0], driven_exact(t0, 1.0, 0.5, sol.t[i]), 200 * tol) << "t = " << sol.t[i];
+      EXPECT_NEAR(mid.q[0], driven_exact(t0, 1.0, 0.5, t0 + len * 0.123), 200 * tol);
+      for (const auto& e : sol.events) EXPECT_NEAR(driven_exact(t0, 1.0, 0.5, e.t), 0.0, 200 * tol);
+    }
 }

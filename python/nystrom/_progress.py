@@ -9,52 +9,64 @@ class _Line:
 
     def __init__(self, t0, t1):
         self.t0, self.t1 = t0, t1
-        self.last = 0.0
+        self.t = t0  # the last time reported
+        self.drawn = 0.0
+
+    def _draw(self, t, end=""):
+        frac = (t - self.t0) / (self.t1 - self.t0)
+        sys.stderr.write(f"\rnystrom: t = {t:.6g} of {self.t1:.6g} ({100 * frac:5.1f}%){end}")
+        sys.stderr.flush()
 
     def update(self, t):
+        self.t = t
         now = time.monotonic()
-        if now - self.last < 0.1:
+        if now - self.drawn < 0.1:
             return
-        self.last = now
-        frac = (t - self.t0) / (self.t1 - self.t0)
-        sys.stderr.write(f"\rnystrom: t = {t:.6g} of {self.t1:.6g} ({100 * frac:5.1f}%)")
-        sys.stderr.flush()
+        self.drawn = now
+        self._draw(t)
 
-    def close(self):
-        sys.stderr.write(f"\rnystrom: t = {self.t1:.6g} of {self.t1:.6g} (100.0%)\n")
-        sys.stderr.flush()
+    def close(self, t=None):
+        self._draw(self.t1 if t is None else t, "\n")
 
 
 class _Tqdm:
     def __init__(self, tqdm, t0, t1):
-        self.t0 = t0
+        self.t0 = self.t = t0
         self.bar = tqdm(total=t1 - t0, unit="t", desc="nystrom")
 
     def update(self, t):
+        self.t = t
         self.bar.n = t - self.t0
         self.bar.refresh()
 
-    def close(self):
+    def close(self, t=None):
+        if t is not None:
+            self.bar.n = t - self.t0
+            self.bar.refresh()
         self.bar.close()
 
 
 class _Callback:
-    def __init__(self, fn):
+    def __init__(self, fn, t0):
         self.fn = fn
+        self.t = t0
 
     def update(self, t):
+        self.t = t
         self.fn(t)
 
-    def close(self):
+    def close(self, t=None):
         pass
 
 
 def make_progress(progress, t0, t1):
-    """None (no progress), or an object with update(t) and close()."""
+    """None (no progress), or an object with update(t), close(t=None) and t, the last time reported.
+    close() ends the display at t1 (a complete run); close(t) at t, where the run actually stopped (an
+    interruption, a terminal event, a failure)."""
     if progress is None or progress is False:
         return None
     if callable(progress):
-        return _Callback(progress)
+        return _Callback(progress, t0)
     if progress is True:
         try:
             from tqdm import tqdm

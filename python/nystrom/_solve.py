@@ -370,14 +370,17 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
 
     # ---- the run ---------------------------------------------------------------------------------
     bar = make_progress(progress, t0, t1)
+    t_end = None  # where the run stopped; unknown when it raised (Ctrl-C): then the last time reported
     try:
         d = _core.solve(kind, params, py_force, list(shape), to_flat(q0), to_flat(v0), t0, t1, method, precision,
                         h_value, n_steps, rtol, atol, None if t_eval is None else _t_eval(t_eval, t0, t1), evs,
                         bool(dense_output), bool(keep_complex), _NO_LIMIT if fixed else int(max_steps),
                         None if bar is None else bar.update, ck_at, ck_problem, ck_file, restart_file)
+        if bar is not None:  # a terminal event ends the output at its time
+            t_end = t1 if d["status"] == 0 else float(d["t"][-1]) if d["status"] == 1 else None
     finally:
         if bar is not None:
-            bar.close()
+            bar.close(bar.t if t_end is None else t_end)
 
     # ---- the result --------------------------------------------------------------------------------
     res = OdeResult()

@@ -2,6 +2,7 @@
 import json
 import os
 import pickle
+import re
 import shutil
 import signal
 import subprocess
@@ -60,6 +61,39 @@ def test_progress_line_on_stderr(capsys):
     nystrom.solve(Kepler(0.5), t_span=(0, 10.0), method="M4", steps=100, t_eval=[10.0], progress=True)
     err = capsys.readouterr().err
     assert "100.0%" in err
+
+
+def last_progress(err):
+    """(t, t1, percent) of the last progress line written on stderr."""
+    m = re.fullmatch(r"nystrom: t = (\S+) of (\S+) \(\s*([0-9.]+)%\)", err.strip().split("\r")[-1])
+    assert m, err[-300:]
+    return float(m.group(1)), float(m.group(2)), float(m.group(3))
+
+
+@pytest.mark.skipif(os.name != "posix", reason="needs POSIX signals")
+def test_progress_line_after_ctrl_c_shows_where_the_run_stopped(capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "tqdm", None)  # the built-in line, whether tqdm is installed or not
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            nystrom.solve(Kepler(0.5), t_span=(0, 1e8), method="M8", h=1e-3, t_eval=[1e8], progress=True)
+    finally:
+        timer.cancel()
+    t, t1, percent = last_progress(capsys.readouterr().err)
+    assert t1 == 1e8 and 0 < t < 1e6 and percent < 1
+
+
+def test_progress_line_after_a_terminal_event_shows_its_time(capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "tqdm", None)
+
+    def at_five(t, q, v):
+        return t - 5.0
+    at_five.terminal = True
+    res = nystrom.solve(Kepler(0.5), t_span=(0, 20.0), method="M4", steps=2000, events=[at_five], progress=True)
+    assert res.status == 1
+    t, t1, percent = last_progress(capsys.readouterr().err)
+    assert t == pytest.approx(5.0) and t1 == 20.0 and percent == pytest.approx(25.0)
 
 
 # ---- ensembles ---------------------------------------------------------------------------------

@@ -19,6 +19,11 @@
 // integrate_to(s, T) advances exactly the time T (the last step is shortened); the controller's step
 // size is kept between calls, so many short calls (one per step of another method) are efficient.
 // As a "method", integrate(s, h, n) makes n such calls of length h.
+//
+// A time-dependent force runs as an autonomous one with the time as one more coordinate (velocity 1,
+// acceleration 0; solve() does so). set_clock(i, end) names that coordinate: GBS then sets it exactly at
+// every substep (t + k H / n, and t + H at the end of a step) instead of summing and extrapolating it, so
+// the force sees no rounding drift of the time and never a time beyond `end` (the end of the span).
 #pragma once
 
 #include <algorithm>
@@ -119,6 +124,13 @@ class GbsIntegrator {
   F& force() { return force_; }
   const std::vector<long>& sequence() const { return nseq_; }
 
+  /// Coordinate `index` of the state is the time (velocity 1, acceleration 0): it is set exactly at every
+  /// substep and never exceeds `end` (see the top of the file).
+  void set_clock(std::size_t index, real_type end) {
+    clock_ = static_cast<long>(index);
+    clock_end_ = end;
+  }
+
   /// Where a run stopped at its observer's request, with the controller's state: integrate_to with the
   /// same span continues from it exactly as if it had not stopped (also on a new integrator after
   /// set_resume_point: a restart from a checkpoint).
@@ -145,6 +157,8 @@ class GbsIntegrator {
     using std::abs;
     if (!(span > real_type(0)) || !is_finite_scalar(span))
       throw std::invalid_argument("GBS: the time span must be positive");
+    if (clock_ >= 0 && static_cast<std::size_t>(clock_) >= s.q.size())
+      throw std::invalid_argument("GBS: the clock coordinate lies outside the state");
     real_type t(0);
     if (!(H_ > real_type(0))) H_ = span;
     long tries = 0;
@@ -217,6 +231,7 @@ class GbsIntegrator {
       delta_[i] = h * (s.v[i] + h / real_type(2) * f0[i]);
       out.q[i] = s.q[i] + delta_[i];
     }
+    set_clock_at(s, H, 1, n, out);
     for (long k = 1; k < n; ++k) {
       force_(out.q, f_);
       ++evals_;
@@ -224,10 +239,21 @@ class GbsIntegrator {
         delta_[i] += h2 * f_[i];
         out.q[i] += delta_[i];
       }
+      set_clock_at(s, H, k + 1, n, out);
     }
     force_(out.q, f_);
     ++evals_;
     for (std::size_t i = 0; i < dim; ++i) out.v[i] = delta_[i] / h + h / real_type(2) * f_[i];
+  }
+
+  // The clock coordinate (set_clock) at substep k of n of the step of H from s: exactly t + k H / n (t + H
+  // at k = n), at most the end of the span. Every row of the table has the same value, so the extrapolated
+  // state has it too.
+  void set_clock_at(const State<V>& s, real_type H, long k, long n, State<V>& out) const {
+    if (clock_ < 0) return;
+    const auto c = static_cast<std::size_t>(clock_);
+    const real_type t = k == n ? real_type(s.q[c] + H) : real_type(s.q[c] + real_type(k) * (H / real_type(n)));
+    out.q[c] = std::min(t, clock_end_);
   }
 
   // Scaled RMS of T[j] - T[j-1] (after extrapolation of row j), relative to y0 and the new value.
@@ -355,6 +381,8 @@ class GbsIntegrator {
   V f0_{}, f_{}, delta_{};
   long evals_ = 0, accepted_ = 0, rejected_ = 0;
   ResumePoint resume_;
+  long clock_ = -1;  // the time coordinate (set_clock), -1: none
+  real_type clock_end_{};
 };
 
 }  // namespace nystrom

@@ -602,6 +602,7 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
   go.atol = run.opt.atol > 0 ? run.opt.atol : run.opt.rtol;
   go.max_steps = run.opt.max_steps;
   GbsIntegrator<VE, typename Run<V, F, VE>::Force> g(run.force(), go);
+  if constexpr (Run<V, F, VE>::td) g.set_clock(run.n, sgn_mul(dir, prob.t1));  // t exact, never past t1
   const R tau0 = sgn_mul(dir, prob.t0);
   const R span = sgn_mul(dir, R(prob.t1 - prob.t0));
   State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
@@ -613,11 +614,11 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
   GbsOptions gp = go;
   gp.rtol = std::max(go.rtol * 1e-3, 100 * as_double(epsilon_of<R>()));
   gp.atol = std::max(go.atol * 1e-3, 100 * as_double(epsilon_of<R>()));
+  GbsIntegrator<VE, typename Run<V, F, VE>::Force> gpart(run.force(), gp);
+  if constexpr (Run<V, F, VE>::td) gpart.set_clock(run.n, sgn_mul(dir, prob.t1));
   Recorder<V, SecondOrderProblem<V, F>> rec(
       prob, run.opt, events, sol, dir,
-      needs_partial_steps(run.opt, events)
-          ? run.partial_step(GbsIntegrator<VE, typename Run<V, F, VE>::Force>(run.force(), gp))
-          : nullptr);
+      needs_partial_steps(run.opt, events) ? run.partial_step(std::move(gpart)) : nullptr);
   if (resume) {
     if (resume->engine != "gbs") throw invalid_input("checkpoint of another engine (" + resume->engine + ")");
     run.restore(*resume, s);

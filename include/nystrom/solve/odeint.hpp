@@ -5,19 +5,23 @@
 //   auto x = std::make_pair(q, p);                                   // or std::make_pair(std::ref(q), std::ref(p))
 //   boost::numeric::odeint::integrate_const(st, force, x, t0, t1, dt, observer);   // observer(x, t)
 //
-// The system is the force a(q) in the form of odeint's symplectic steppers' momentum function,
-// force(q, dpdt) (unit mass: p = v). The state is a pair (q, p) of V, or of references to V
-// (std::reference_wrapper or boost::reference_wrapper). Each do_step is one step of the method
-// (compensated summation and FSAL forces carry over between steps while the caller does not move
-// the state). This header includes no Boost header: it only names odeint's stepper_tag.
+// The system is the force in the form of odeint's symplectic steppers' momentum function (unit mass:
+// p = v): force(q, dpdt) for a(q), or force(t, q, dpdt) for a time-dependent a(t, q), which gets the
+// time of each of its evaluations (t as one more coordinate of the state, velocity 1, as solve() does;
+// t + c_i dt at the stages). Velocity-dependent forces are not supported. The state is a pair (q, p) of
+// V, or of references to V (std::reference_wrapper or boost::reference_wrapper). Each do_step is one
+// step of the method (compensated summation and FSAL forces carry over between steps while the caller
+// does not move the state). This header includes no Boost header: it only names odeint's stepper_tag.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <memory>
 #include <string>
 #include <type_traits>
 #include <typeinfo>
 #include <utility>
+#include <vector>
 
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
@@ -27,6 +31,20 @@ struct stepper_tag;
 }  // namespace boost::numeric::odeint
 
 namespace nystrom {
+
+namespace odeint_detail {
+/// V with one more coordinate (the time of a time-dependent force).
+template <class V>
+struct with_clock;
+template <class S, std::size_t N>
+struct with_clock<std::array<S, N>> {
+  using type = std::array<S, N + 1>;
+};
+template <class S, class A>
+struct with_clock<std::vector<S, A>> {
+  using type = std::vector<S, A>;
+};
+}  // namespace odeint_detail
 
 template <class V>
 class OdeintStepper {
@@ -49,10 +67,11 @@ class OdeintStepper {
   order_type order() const { return static_cast<order_type>(def_.info.order); }
   long force_evals() const { return *cache_ ? (*cache_)->force_evals() : 0; }
 
-  /// One step of size dt from the state (q, p) in place; t is not used (the force is autonomous).
+  /// One step of size dt from the state (q, p) at time t, in place; a time-dependent force
+  /// system(t, q, dpdt) is called at the times of its evaluations within the step.
   template <class System, class StateInOut>
-  void do_step(System system, StateInOut& x, time_type /*t*/, time_type dt) {
-    step(system, unwrap(x.first), unwrap(x.second), dt);
+  void do_step(System system, StateInOut& x, time_type t, time_type dt) {
+    step(system, unwrap(x.first), unwrap(x.second), t, dt);
   }
   /// A pair of references (std::make_pair(std::ref(q), std::ref(p))), or a temporary pair that
   /// integrate_const holds (odeint passes it on as const; its members are the state to advance).
@@ -71,6 +90,12 @@ class OdeintStepper {
     }
   }
 
+  /// Which form the force has: system(q, dpdt), or (if not) system(t, q, dpdt).
+  template <class System>
+  static constexpr bool time_dependent =
+      !std::is_invocable_v<System&, const V&, V&> && std::is_invocable_v<System&, const time_type&, const V&, V&>;
+  using VT = typename odeint_detail::with_clock<V>::type;  // (q, t) of a time-dependent force
+
   // The force seen by the engine: the current system, reached through a pointer that every do_step
   // sets, so that the integrator (coefficients converted once) lives across steps.
   template <class System>
@@ -78,6 +103,27 @@ class OdeintStepper {
     System* sys = nullptr;
     void operator()(const V& q, V& a) const { (*sys)(q, a); }
   };
+  // A time-dependent one on (q, t): t is the last coordinate, its acceleration 0.
+  template <class System>
+  struct ClockedSystemRef {
+    System* sys = nullptr;
+    std::size_t n = 0;
+    V qb{}, ab{};
+    void operator()(const VT& q, VT& a) {
+      if constexpr (!is_std_array<V>::value) {
+        qb.resize(n);
+        ab.resize(n);
+      }
+      for (std::size_t i = 0; i < n; ++i) qb[i] = q[i];
+      (*sys)(static_cast<const time_type&>(q[n]), static_cast<const V&>(qb), ab);
+      for (std::size_t i = 0; i < n; ++i) a[i] = ab[i];
+      a[n] = typename V::value_type(0);
+    }
+  };
+  template <class System>
+  using ForceRef = std::conditional_t<time_dependent<System>, ClockedSystemRef<System>, SystemRef<System>>;
+  template <class System>
+  using EngineVector = std::conditional_t<time_dependent<System>, VT, V>;
 
   struct Holder {
     virtual ~Holder() = default;
@@ -86,13 +132,17 @@ class OdeintStepper {
   };
   template <class System>
   struct TypedHolder : Holder {
-    TypedHolder(const MethodDef& def, EngineOptions opt) : integ(make_integrator<V>(def, SystemRef<System>{}, opt)) {}
+    TypedHolder(const MethodDef& def, EngineOptions opt)
+        : integ(make_integrator<EngineVector<System>>(def, ForceRef<System>{}, opt)) {}
     long force_evals() const override { return integ.force_evals(); }
-    Integrator<V, SystemRef<System>> integ;
+    Integrator<EngineVector<System>, ForceRef<System>> integ;
   };
 
   template <class System>
-  void step(System& system, V& q, V& p, time_type dt) {
+  void step(System& system, V& q, V& p, time_type t, time_type dt) {
+    static_assert(std::is_invocable_v<System&, const V&, V&> || time_dependent<System>,
+                  "nystrom::OdeintStepper: the system must be the force, callable as force(q, dpdt) or "
+                  "force(t, q, dpdt) (unit mass); velocity-dependent forces a(t, q, v) are not supported");
     if (q.size() != p.size()) throw invalid_input("inconsistent state: q and p differ in size");
     auto& slot = *cache_;
     if (!slot || *slot->type != typeid(System)) {
@@ -102,10 +152,44 @@ class OdeintStepper {
     }
     auto& integ = static_cast<TypedHolder<System>&>(*slot).integ;
     integ.force().sys = &system;
-    State<V> s{std::move(q), std::move(p)};
-    integ.integrate(s, dt, 1);
-    q = std::move(s.q);
-    p = std::move(s.v);
+    if constexpr (!time_dependent<System>) {
+      (void)t;
+      State<V> s{std::move(q), std::move(p)};
+      integ.integrate(s, dt, 1);
+      q = std::move(s.q);
+      p = std::move(s.v);
+    } else {
+      const std::size_t n = q.size();
+      integ.force().n = n;
+      State<VT> s;
+      if constexpr (!is_std_array<V>::value) {
+        s.q.resize(n + 1);
+        s.v.resize(n + 1);
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        s.q[i] = q[i];
+        s.v[i] = p[i];
+      }
+      s.q[n] = t;
+      s.v[n] = time_type(1);
+      // The time comes from the caller at every step: while the caller does not move (q, p), the
+      // compensation carries of q and p go on, and that of the time starts again.
+      auto& c = integ.compensator();
+      if (c.valid && c.lastq.size() == n + 1 && c.cq.size() == n + 1) {
+        bool same = true;
+        for (std::size_t i = 0; i < n && same; ++i) same = c.lastq[i] == s.q[i] && c.lastv[i] == s.v[i];
+        if (same) {
+          c.lastq[n] = s.q[n];
+          c.lastv[n] = s.v[n];
+          c.cq[n] = c.cv[n] = typename V::value_type(0);
+        }
+      }
+      integ.integrate(s, dt, 1);
+      for (std::size_t i = 0; i < n; ++i) {
+        q[i] = s.q[i];
+        p[i] = s.v[i];
+      }
+    }
   }
 
   MethodDef def_;

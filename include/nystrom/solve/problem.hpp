@@ -5,6 +5,7 @@
 //   void(const V& q, V& a)                 time-independent (the engines call it directly: no overhead)
 //   void(const T& t, const V& q, V& a)     time-dependent, T the real type of V's elements
 // V is any container with size() and operator[] (std::array<T, N>, std::vector<T>) of a real T.
+// Velocity-dependent forces a(t, q, v) are not supported (a clear compile-time error says so).
 #pragma once
 
 #include <cmath>
@@ -42,7 +43,13 @@ class SecondOrderProblem {
   using force_type = F;
   static_assert(!is_complex_v<scalar_type>,
                 "nystrom: a problem's state is real (complex-coefficient methods complexify it themselves)");
-  static_assert(ForceFor<F, V>,
+  static constexpr bool velocity_dependent =
+      !ForceFor<F, V> &&
+      (std::invocable<F&, const real_type&, const V&, const V&, V&> || std::invocable<F&, const V&, const V&, V&>);
+  static_assert(!velocity_dependent,
+                "nystrom: velocity-dependent forces a(t, q, v) are not supported by this interface: the force must "
+                "be a(q) or a(t, q), callable as force(q, a) or force(t, q, a)");
+  static_assert(ForceFor<F, V> || velocity_dependent,
                 "nystrom: the force must be callable as force(q, a) or force(t, q, a), with const V& q, V& a of the "
                 "problem's state type V and t of its real type");
   /// Whether the force takes the time (then the engines carry t as one more coordinate).
