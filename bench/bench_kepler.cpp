@@ -340,12 +340,25 @@ void bm_bare(benchmark::State& state, const std::string& method, bool saveat) {
   }
 }
 
+/// solve(): on std::vector<double> the compiled path (libnystrom, the force behind ErasedForce); `inl`: the
+/// inline path (solve_inline, the driver compiled here for KeplerForce), the baseline of the compiled one.
 template <class W>
-void bm_solve(benchmark::State& state, const std::string& method, bool saveat) {
+void bm_solve(benchmark::State& state, const std::string& method, bool saveat, bool inl = false) {
   const auto prob = driver_problem<W>();
   const SolveOptions opt = driver_options(saveat);
   for (auto _ : state) {
-    auto sol = solve(prob, method, opt);
+    auto sol = inl ? solve_inline(prob, method, opt) : solve(prob, method, opt);
+    benchmark::DoNotOptimize(sol);
+  }
+}
+
+/// DP12-adaptive over the driver's span at rtol 1e-10, end state only: compiled against inline path.
+template <class W>
+void bm_adaptive(benchmark::State& state, bool inl) {
+  const auto prob = driver_problem<W>();
+  const SolveOptions opt{.rtol = 1e-10, .t_eval = {driver_t1()}};
+  for (auto _ : state) {
+    auto sol = inl ? solve_inline(prob, "DP12-adaptive", opt) : solve(prob, "DP12-adaptive", opt);
     benchmark::DoNotOptimize(sol);
   }
 }
@@ -423,6 +436,14 @@ class SummaryReporter : public bench::MinTimeReporter {
       }
     }
     if (header) std::printf("(target: solve / bare <= 1.05)\n");
+    // The compiled path of solve() against the inline one on std::vector<double> (the same steps, bit for bit).
+    std::printf("\nsolve() on std::vector<double>: compiled (libnystrom) / inline (solve_inline), time per run\n");
+    for (const std::string m : {"VV", "M8", "DP12-adaptive"}) {
+      const double* c = best("compiled-vector/" + m);
+      const double* i = best("inline-vector/" + m);
+      if (c && i) std::printf("%-17s %12.2f %12.2f %9.3f\n", m.c_str(), *c, *i, *c / *i);
+    }
+    std::printf("(target: compiled / inline <= 1.15)\n");
   }
 };
 
@@ -463,6 +484,20 @@ int main(int argc, char** argv) {
       })->MinTime(0.2);
     }
   }
+  for (const auto& m : kDriverMethods) {
+    benchmark::RegisterBenchmark(("compiled-vector/" + m).c_str(), [m](benchmark::State& s) {
+      bm_solve<VD>(s, m, false, false);
+    })->MinTime(0.2);
+    benchmark::RegisterBenchmark(("inline-vector/" + m).c_str(), [m](benchmark::State& s) {
+      bm_solve<VD>(s, m, false, true);
+    })->MinTime(0.2);
+  }
+  benchmark::RegisterBenchmark("compiled-vector/DP12-adaptive", [](benchmark::State& s) {
+    bm_adaptive<VD>(s, false);
+  })->MinTime(0.2);
+  benchmark::RegisterBenchmark("inline-vector/DP12-adaptive", [](benchmark::State& s) {
+    bm_adaptive<VD>(s, true);
+  })->MinTime(0.2);
   if (!bench::initialize({argv, argv + argc}, 5)) return 1;  // five repetitions unless told otherwise
   if (!check_hand_loops() || !check_driver()) return 1;
   SummaryReporter reporter;

@@ -1,4 +1,4 @@
-// The Python module's binding of solve() (nystrom/solve.hpp): the one driver runs every integration
+// The Python module's binding of solve() (nystrom/solve.hpp; compiled in libnystrom for std::vector states): the one driver runs every integration
 // that nystrom.solve asks for. This header converts a request built from Python arguments into a
 // SecondOrderProblem, events and SolveOptions, runs solve() (with the GIL released when neither the
 // force nor an event calls into Python) and converts the Solution back: arrays of doubles, the final
@@ -26,7 +26,8 @@
 #include <vector>
 
 #include "nystrom/core/extended.hpp"
-#include "nystrom/solve/solve.hpp"
+#include "nystrom/methods/method.hpp"
+#include "nystrom/solve.hpp"
 
 namespace nystrom::python {
 
@@ -160,7 +161,11 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   using R = real_t<typename V::value_type>;
   const std::size_t n = r.q0.size();
   const std::size_t m = n + (time_coordinate ? 1 : 0);
-  V q0 = solve_detail::make_vector<V>(m), v0 = solve_detail::make_vector<V>(m);
+  V q0{}, v0{};
+  if constexpr (requires { q0.resize(m); }) {
+    q0.resize(m);
+    v0.resize(m);
+  }
   if (q0.size() != m)
     throw invalid_input("the state has " + std::to_string(n) + " coordinates, this problem " +
                         std::to_string(q0.size()));

@@ -4,6 +4,7 @@
 
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/problems/nbody.hpp"
+#include "nystrom/solve_inline.hpp"  // Kepler on std::array: the driver compiled for its force
 #include "solve_binding.hpp"
 
 namespace nystrom::python {
