@@ -58,10 +58,10 @@ TEST(DenseOutput, InsideEveryStepWithinTenTimesTheStepEndErrorForEveryFixedStepM
     const long fps = std::max(1, def.info.forces_per_step);
     if (def.info.order <= 8) {
       long steps = std::max(16L, 1000L / fps);
-      Errors e = errors(solve(prob, def, {.steps = steps}), kp);
+      Errors e = errors(solve(prob, def, {.steps = steps, .dense = true}), kp);
       while (e.ends < 1e-10 && steps > 16) {
         steps /= 2;
-        e = errors(solve(prob, def, {.steps = steps}), kp);
+        e = errors(solve(prob, def, {.steps = steps, .dense = true}), kp);
       }
       EXPECT_GT(e.ends, 1e-12) << steps << " steps";
       EXPECT_LE(e.inside, 10 * e.ends) << steps << " steps: step ends " << e.ends << ", inside " << e.inside;
@@ -70,8 +70,8 @@ TEST(DenseOutput, InsideEveryStepWithinTenTimesTheStepEndErrorForEveryFixedStepM
       ++low;
     } else {
       const long steps = std::max(8L, 300L / fps);
-      const Errors e1 = errors(solve(prob, def, {.steps = steps}), kp);
-      const Errors e2 = errors(solve(prob, def, {.steps = 2 * steps}), kp);
+      const Errors e1 = errors(solve(prob, def, {.steps = steps, .dense = true}), kp);
+      const Errors e2 = errors(solve(prob, def, {.steps = 2 * steps, .dense = true}), kp);
       const double p = std::log2(e1.inside / e2.inside), p_ends = std::log2(e1.ends / e2.ends);
       std::printf("dense %-10s order %2d, %ld/%ld steps: inside %.2e/%.2e, observed order %.1f (step ends %.1f)\n",
                   def.info.name.c_str(), def.info.order, steps, 2 * steps, e1.inside, e2.inside, p, p_ends);
@@ -93,7 +93,7 @@ TEST(DenseOutput, AdaptiveEnginesAndGbsKeepTheirAccuracyInsideTheirSteps) {
   const auto prob = kepler(0.5, 0.0, 2 * pi);
   for (const std::string m : {"DP12-adaptive", "M12-adaptive", "M8-adaptive", "GBS"}) {
     SCOPED_TRACE(m);
-    const auto sol = solve(prob, m, {.rtol = 1e-10});
+    const auto sol = solve(prob, m, {.rtol = 1e-10, .dense = true});
     const Errors e = errors(sol, kp);
     std::printf("dense %-14s %4ld steps: step ends %.2e, inside %.2e (Hermite %.2e)\n", m.c_str(), sol.accepted, e.ends,
                 e.inside, e.hermite);
@@ -107,7 +107,7 @@ TEST(DenseOutput, OutlivesTheProblemAndItsForce) {
     const std::vector<double> w2 = {4.0};
     auto f = [w2](const std::vector<double>& q, std::vector<double>& a) { a[0] = -w2[0] * q[0]; };
     const SecondOrderProblem prob(f, std::vector<double>{1.0}, std::vector<double>{0.0}, 0.0, 3.0);
-    return solve(prob, "M8", {.steps = 30});
+    return solve(prob, "M8", {.steps = 30, .dense = true});
   };
   const auto sol = make();
   const auto copy = sol;
@@ -126,7 +126,7 @@ TEST(DenseOutput, BackwardAndTimeDependentProblems) {
                                 std::vector<double>{(-std::sin(5.0) + 2 * std::sin(10.0)) / 3}, 5.0, 0.0);
   for (const std::string m : {"M6", "DP12-adaptive", "GBS"}) {
     SCOPED_TRACE(m);
-    const auto sol = solve(back, m, {.steps = 40, .rtol = 1e-10});
+    const auto sol = solve(back, m, {.steps = 40, .rtol = 1e-10, .dense = true});
     double ends = 0, inside = 0;
     for (std::size_t k = 0; k < sol.t.size(); ++k) ends = std::max(ends, std::abs(sol.q[k][0] - exact(sol.t[k])));
     for (std::size_t k = 0; k + 1 < sol.t.size(); ++k)

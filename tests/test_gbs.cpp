@@ -253,6 +253,7 @@ TEST(Gbs, TimeDependentForceThroughSolveSeesOnlyTimesWithinTheSpan) {
       const auto prob = SecondOrderProblem(force, V{1.0}, V{0.5}, t0, t1);
       SolveOptions opt;
       opt.rtol = tol;
+      opt.dense = true;
       for (int i = 1; i <= 7; ++i) opt.t_eval.push_back(t0 + len * i / 7);
       const std::vector<Event<V>> events = {{"q=0", [](const double&, const V& q, const V&) { return q[0]; }}};
       const auto sol = solve(prob, "GBS", opt, events);

@@ -140,7 +140,7 @@ TEST(Solve, OutputTimesComeFromTheDenseOutput) {
   const auto prob = kepler(0.5, 0.0, 2 * pi);
   std::vector<double> te;
   for (int i = 0; i <= 50; ++i) te.push_back(2 * pi * i / 50);
-  const auto sol = solve(prob, "M8", {.steps = 2000, .t_eval = te});
+  const auto sol = solve(prob, "M8", {.steps = 2000, .t_eval = te, .dense = true});
   ASSERT_EQ(sol.t.size(), te.size());
   for (std::size_t i = 0; i < te.size(); ++i) {
     EXPECT_EQ(sol.t[i], te[i]);
@@ -407,11 +407,11 @@ TEST(SolveEvents, KeplerApsidesAreTheAnalyticOnesToTheMethodsAccuracy) {
     SolveOptions opt;
     bool target;  // accurate enough for the times to 1e-12 relative
   };
-  const std::vector<Case> cases = {{"DP12-adaptive", {.rtol = 1e-12}, true},
-                                   {"M8", {.steps = 60000}, true},
-                                   {"M14-adaptive", {.rtol = 1e-12}, true},
-                                   {"GBS", {.rtol = 1e-12}, false},
-                                   {"M6", {.steps = 6000}, false}};
+  const std::vector<Case> cases = {{"DP12-adaptive", {.rtol = 1e-12, .dense = true}, true},
+                                   {"M8", {.steps = 60000, .dense = true}, true},
+                                   {"M14-adaptive", {.rtol = 1e-12, .dense = true}, true},
+                                   {"GBS", {.rtol = 1e-12, .dense = true}, false},
+                                   {"M6", {.steps = 6000, .dense = true}, false}};
   for (const auto& c : cases) {
     SCOPED_TRACE(c.method);
     const auto sol = solve(prob, c.method, c.opt, apsides);
@@ -441,11 +441,11 @@ TEST(SolveEvents, TerminalEventEndsTheRunThere) {
   const std::vector<Event<V2>> ev = {apsides[0]};
   std::vector<Event<V2>> terminal = ev;
   terminal[0].terminal = true;
-  const auto sol = solve(prob, "DP12-adaptive", {.rtol = 1e-13}, terminal);
+  const auto sol = solve(prob, "DP12-adaptive", {.rtol = 1e-13, .dense = true}, terminal);
   EXPECT_EQ(sol.status, SolveStatus::terminated_by_event);
   ASSERT_EQ(sol.events.size(), 1u);
   // The same run without the terminal flag takes the same steps up to there and finds the same time.
-  const auto full = solve(prob, "DP12-adaptive", {.rtol = 1e-13}, ev);
+  const auto full = solve(prob, "DP12-adaptive", {.rtol = 1e-13, .dense = true}, ev);
   ASSERT_GE(full.events.size(), 1u);
   EXPECT_EQ(full.events[0].t, sol.t_final);
   EXPECT_NEAR(sol.t_final, pi, apsis_time_bound(full, kp, pi));
