@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "nystrom/core/error.hpp"
 #include "nystrom/methods/blanes_moan2002.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/chin2010.hpp"
@@ -85,7 +86,6 @@ const std::vector<MethodDef>& catalog() {
   return all;
 }
 
-/// Resolves a method specification (see the top of this file). Throws std::invalid_argument.
 namespace detail {
 std::atomic<MethodFileReader>& method_file_reader() {
   static std::atomic<MethodFileReader> reader{nullptr};
@@ -95,7 +95,8 @@ std::atomic<MethodFileReader>& method_file_reader() {
 
 void set_method_file_reader(MethodFileReader reader) { detail::method_file_reader().store(reader); }
 
-MethodDef resolve_method(const std::string& spec) {
+namespace {
+MethodDef resolve_spec(const std::string& spec) {
   if (spec.empty()) throw std::invalid_argument("empty method name");
   for (const auto& d : catalog()) {
     if (d.info.name == spec) return d;
@@ -186,6 +187,17 @@ MethodDef resolve_method(const std::string& spec) {
     return finalize(d);
   }
   throw std::invalid_argument("unknown method '" + spec + "' (see `nystrom methods`)");
+}
+
+}  // namespace
+
+/// Resolves a method specification (see methods/catalog.hpp); every refusal is an invalid_input.
+MethodDef resolve_method(const std::string& spec) {
+  try {
+    return resolve_spec(spec);
+  } catch (const std::invalid_argument& e) {
+    throw invalid_input(e.what());
+  }
 }
 
 }  // namespace nystrom

@@ -36,7 +36,7 @@ void finalize_info(MethodDef& d);
 /// All named methods, with derived fields filled in. Built once.
 const std::vector<MethodDef>& catalog();
 
-/// Resolves a method specification (see the top of this file). Throws std::invalid_argument.
+/// Resolves a method specification (see the top of this file). Throws nystrom::invalid_input.
 MethodDef resolve_method(const std::string& spec);
 
 /// Reads the method file of a "file:PATH" specification. The method-file format, which verifies a file's
