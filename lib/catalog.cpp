@@ -200,4 +200,20 @@ MethodDef resolve_method(const std::string& spec) {
   }
 }
 
+MethodDef gbs_method_def() {
+  MethodDef d;
+  d.info.name = "GBS";
+  d.info.family = "extrapolation";
+  d.info.adaptive = true;
+  d.info.source = "Gragg (1965); Bulirsch & Stoer (1966); Hairer, Norsett & Wanner I, sec. II.9/II.14 (ODEX2)";
+  d.info.description = "Gragg-Bulirsch-Stoer extrapolation, adaptive step and order";
+  d.build = []() -> MethodData { throw invalid_input("GBS has no coefficient table"); };
+  return d;
+}
+
+MethodDef resolve_solve_method(const std::string& spec) {
+  if (spec == "GBS" || spec == "gbs") return gbs_method_def();
+  return resolve_method(spec);
+}
+
 }  // namespace nystrom

@@ -10,8 +10,8 @@
 #include <stdexcept>
 
 #include "cli.hpp"
-#include "nystrom/core/precision.hpp"
 #include "experiments/nbody_run.hpp"
+#include "nystrom/core/precision.hpp"
 #include "nystrom/methods/catalog.hpp"
 
 namespace nystrom::cli {
@@ -76,21 +76,9 @@ const std::vector<std::string>& problem_names() {
   return names;
 }
 
-MethodDef gbs_method() {
-  MethodDef d;
-  d.info.name = "GBS";
-  d.info.family = "extrapolation";
-  d.info.adaptive = true;
-  d.info.source = "Gragg (1965); Bulirsch & Stoer (1966); Hairer, Norsett & Wanner I, sec. II.9/II.14 (ODEX2)";
-  d.info.description = "Gragg-Bulirsch-Stoer extrapolation, adaptive step and order";
-  d.build = []() -> MethodData { throw std::invalid_argument("GBS has no coefficient table"); };
-  return d;
-}
+MethodDef gbs_method() { return gbs_method_def(); }
 
-MethodDef resolve_run_method(const std::string& spec) {
-  if (spec == "GBS" || spec == "gbs") return gbs_method();
-  return resolve_method(spec);
-}
+MethodDef resolve_run_method(const std::string& spec) { return resolve_solve_method(spec); }
 
 namespace {
 

@@ -71,9 +71,9 @@ struct MeteredForce {
 };
 
 /// The Gragg-Bulirsch-Stoer reference integrator is a method of `run`/`sweep` too, named "GBS"
-/// (adaptive: it needs --tol). This returns its pseudo catalog entry.
+/// (adaptive: it needs --tol): gbs_method_def() of the catalog.
 MethodDef gbs_method();
-/// resolve_method() plus "GBS".
+/// resolve_solve_method(): resolve_method() plus "GBS".
 MethodDef resolve_run_method(const std::string& spec);
 
 struct RunReport {

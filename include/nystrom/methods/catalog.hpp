@@ -39,6 +39,13 @@ const std::vector<MethodDef>& catalog();
 /// Resolves a method specification (see the top of this file). Throws nystrom::invalid_input.
 MethodDef resolve_method(const std::string& spec);
 
+/// The Gragg-Bulirsch-Stoer extrapolation integrator (engines/gbs.hpp) as a method for solve(): adaptive
+/// step and order, tolerances rtol and atol (family "extrapolation"; no coefficient table).
+MethodDef gbs_method_def();
+
+/// What solve() resolves: resolve_method(spec), and "GBS" (or "gbs") for the extrapolation integrator.
+MethodDef resolve_solve_method(const std::string& spec);
+
 /// Reads the method file of a "file:PATH" specification. The method-file format, which verifies a file's
 /// declared order by the BCH expansion, lives above the methods (analysis/method_file.hpp); including
 /// that header installs its reader here, so that resolving a catalog method never compiles the BCH

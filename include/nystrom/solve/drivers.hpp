@@ -59,29 +59,6 @@
 
 namespace nystrom {
 
-/// The Gragg-Bulirsch-Stoer extrapolation integrator (engines/gbs.hpp) as a method for solve(): adaptive
-/// step and order, tolerances rtol and atol.
-inline MethodDef gbs_method_def() {
-  MethodDef d;
-  d.info.name = "GBS";
-  d.info.family = "extrapolation";
-  d.info.adaptive = true;
-  d.info.source = "Gragg (1965); Bulirsch & Stoer (1966); Hairer, Norsett & Wanner I, sec. II.9/II.14 (ODEX2)";
-  d.info.description = "Gragg-Bulirsch-Stoer extrapolation, adaptive step and order";
-  d.build = []() -> MethodData { throw invalid_input("GBS has no coefficient table"); };
-  return d;
-}
-
-/// resolve_method(spec), and "GBS" (or "gbs") for the extrapolation integrator.
-inline MethodDef resolve_solve_method(const std::string& spec) {
-  if (spec == "GBS" || spec == "gbs") return gbs_method_def();
-  try {
-    return resolve_method(spec);
-  } catch (const std::invalid_argument& e) {
-    throw invalid_input(e.what());
-  }
-}
-
 namespace solve_detail {
 
 /// The vector the engines integrate: V (or its complex counterpart) with one more coordinate for t
