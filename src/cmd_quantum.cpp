@@ -1,14 +1,10 @@
 // `nystrom quantum --potential harmonic --dims 1 --grid 256 --box 20 --method M8 --dt 0.05 --steps 200
 //  [--imaginary-time] [--x0 1] [--p0 0] [--g 0] [--precision double|long-double] [--json] [--plot FILE.png]`
 #include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -23,8 +19,6 @@
 #ifdef NYSTROM_HAVE_MPI
 #include "nystrom/quantum/fftw_mpi.hpp"
 #endif
-
-extern char** environ;
 
 namespace {
 
@@ -91,10 +85,9 @@ class MpiSession {
 
 /// The potential's values from a text file: numbers separated by white space, `#` to the end of a line a
 /// comment, one per grid point in row-major order (last axis fastest), at x_i = -L/2 + i L/n.
+/// A regular file of at most 64 MiB (nystrom::read_input_file).
 std::vector<double> read_potential_file(const std::string& path, std::size_t points) {
-  std::ifstream in(path);
-  if (path.empty() || std::filesystem::is_directory(path) || !in)
-    throw UsageError("cannot read --potential-file '" + path + "'");
+  std::istringstream in(nystrom::read_input_file<UsageError>(path, "--potential-file"));
   std::vector<double> v;
   std::string line;
   for (long number = 1; std::getline(in, line); ++number) {
@@ -107,7 +100,6 @@ std::vector<double> read_potential_file(const std::string& path, std::size_t poi
       v.push_back(nystrom::cli::parse_double(w, "--potential-file value on line " + std::to_string(number)));
     }
   }
-  if (in.bad()) throw UsageError("cannot read --potential-file '" + path + "'");
   if (v.size() != points)
     throw UsageError("--potential-file '" + path + "' has " + std::to_string(v.size()) + " values for " +
                      std::to_string(points) + " grid points");
@@ -124,64 +116,21 @@ std::vector<double> parse_vector(const std::string& text, const std::string& wha
   return v;
 }
 
-/// Runs gnuplot on a script and data of fixed names in a fresh temporary folder (no shell, no user string
-/// in the script), then moves the picture to `target` (copied next to it first, so a failure leaves any
-/// existing file untouched).
+/// Draws <x_1>(t) (or the energy) and the norm with gnuplot: the data inline in the script, nothing of the
+/// user's in it; the picture is written as every result file of the tool (nystrom::cli::render_png).
 void plot_samples(const std::string& target, const QuantumResult& r, bool imaginary) {
-  namespace fs = std::filesystem;
-  if (target.empty()) throw UsageError("empty plot file name");
-  const fs::path out(target);
-  const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir)) throw UsageError("cannot write '" + target + "': folder does not exist");
-  std::string tmpl = (fs::temp_directory_path() / "nystrom-quantum-XXXXXX").string();
-  if (!::mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary folder for the plot");
-  const fs::path tmp(tmpl);
-  std::error_code ec;
-  struct Cleanup {
-    fs::path p;
-    ~Cleanup() {
-      std::error_code e;
-      fs::remove_all(p, e);
-    }
-  } cleanup{tmp};
-  {
-    std::ofstream data(tmp / "data.txt");
-    data.precision(17);
-    for (const auto& s : r.samples)
-      data << s.time << " " << (imaginary ? s.energy : s.mean_x.at(0)) << " " << s.norm << "\n";
-  }
-  {
-    std::ofstream script(tmp / "plot.gp");
-    script << "set terminal pngcairo size 900,600\nset output 'out.png'\nset grid\n"
-           << "set xlabel '" << (imaginary ? "imaginary time" : "time") << "'\n"
-           << "set ylabel '" << (imaginary ? "energy" : "<x_1>") << "'\nset y2label 'norm'\nset y2tics\n"
-           << "plot 'data.txt' using 1:2 with lines lw 2 title '" << (imaginary ? "energy" : "<x_1>")
-           << "', 'data.txt' using 1:3 axes x1y2 with lines title 'norm'\n";
-  }
-  std::string prog = "gnuplot", script = "plot.gp";
-  char* argv[] = {prog.data(), script.data(), nullptr};
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
-  // gnuplot reads and writes relative to its working folder: run it in the temporary folder
-  const fs::path cwd = fs::current_path();
-  fs::current_path(tmp);
-  pid_t pid = 0;
-  const int rc = ::posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
-  fs::current_path(cwd);
-  posix_spawn_file_actions_destroy(&actions);
-  int status = 0;
-  if (rc != 0 || ::waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
-      !fs::exists(tmp / "out.png"))
-    throw std::runtime_error("gnuplot failed to draw '" + target + "' (is gnuplot installed?)");
-  const fs::path staged = dir / ("." + out.filename().string() + ".tmp." + std::to_string(::getpid()));
-  fs::copy_file(tmp / "out.png", staged, fs::copy_options::overwrite_existing, ec);
-  if (!ec) fs::rename(staged, out, ec);
-  if (ec) {
-    fs::remove(staged, ec);
-    throw std::runtime_error("cannot write '" + target + "'");
-  }
+  std::ostringstream script;
+  script.precision(17);
+  script << "set terminal pngcairo size 900,600\nset output 'plot.png'\nset grid\n"
+         << "set xlabel '" << (imaginary ? "imaginary time" : "time") << "'\n"
+         << "set ylabel '" << (imaginary ? "energy" : "<x_1>") << "'\nset y2label 'norm'\nset y2tics\n"
+         << "$data << EOD\n";
+  for (const auto& s : r.samples)
+    script << s.time << " " << (imaginary ? s.energy : s.mean_x.at(0)) << " " << s.norm << "\n";
+  script << "EOD\n"
+         << "plot $data using 1:2 with lines lw 2 title '" << (imaginary ? "energy" : "<x_1>")
+         << "', $data using 1:3 axes x1y2 with lines title 'norm'\n";
+  nystrom::cli::render_png(target, script.str());
 }
 
 template <class R>
@@ -288,6 +237,7 @@ nystrom::cli::Registrar reg(
         nystrom::cli::parse_double(o->g, "--g");
         if (o->precision != "double" && o->precision != "long-double")
           throw UsageError("--precision must be double or long-double, got '" + o->precision + "'");
+        if (!o->plot.empty()) nystrom::cli::check_plot_target(o->plot);
         const MpiSession mpi;
         const QuantumResult r = o->precision == "double" ? run<double>(*o, mpi) : run<long double>(*o, mpi);
         if (mpi.rank() != 0) return 0;
