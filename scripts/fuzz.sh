@@ -2,14 +2,14 @@
 # Builds the libFuzzer harnesses of fuzz/ with clang-14 (ASan + UBSan) and runs each for a fixed time,
 # starting from the seed corpus in fuzz/corpus/<harness>/. Fails on any crash, leak, UB report, timeout or
 # out-of-memory. Environment: NYSTROM_FUZZ_SECONDS (per harness, default 30), NYSTROM_FUZZ_HARNESSES (default
-# all four), NYSTROM_FUZZ_JOBS (build jobs, default nproc), NYSTROM_FUZZ_BUILD (a build folder configured with
+# all five), NYSTROM_FUZZ_JOBS (build jobs, default nproc), NYSTROM_FUZZ_BUILD (a build folder configured with
 # NYSTROM_BUILD_FUZZERS=ON, e.g. by the asan-fuzz preset, to build and run the harnesses there; default: build/fuzz,
 # configured here). New inputs found go to build/fuzz/corpus/<harness>/,
 # never into the repository's seed corpus. docs/fuzzing.md: how to run longer and how to keep a finding.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${NYSTROM_FUZZ_SECONDS:-30}
-harnesses=${NYSTROM_FUZZ_HARNESSES:-"method_spec method_file particles cli"}
+harnesses=${NYSTROM_FUZZ_HARNESSES:-"method_spec method_file particles checkpoint cli"}
 jobs=${NYSTROM_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}
 build=${NYSTROM_FUZZ_BUILD:-build/fuzz}
 san="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"

@@ -37,6 +37,6 @@ echo "   ($(( $(date +%s) - start )) s so far)"
 
 echo "== libFuzzer harnesses (ASan + UBSan), ${NYSTROM_FUZZ_SECONDS:-20} s each"
 NYSTROM_FUZZ_BUILD=build/asan-fuzz NYSTROM_FUZZ_SECONDS=${NYSTROM_FUZZ_SECONDS:-20} \
-  NYSTROM_FUZZ_HARNESSES="method_spec method_file particles cli" bash scripts/fuzz.sh
+  NYSTROM_FUZZ_HARNESSES="method_spec method_file particles checkpoint cli" bash scripts/fuzz.sh
 
 echo "== all tests passed in $(( $(date +%s) - start )) s"

@@ -35,23 +35,16 @@ std::vector<Command>& commands() {
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// Temporary files and signals. The handler may only call async-signal-safe functions: the registered paths
-// live in fixed buffers, written before a slot is marked in use.
+// Signals. The handler may only call async-signal-safe functions: the temporary paths are those registered
+// with nystrom::TemporaryPath (fixed buffers, core/files.hpp).
 
 namespace {
 
-constexpr int kSlots = 32;
-constexpr std::size_t kPathMax = 4096;
-char g_paths[kSlots][kPathMax];
-volatile std::sig_atomic_t g_kind[kSlots];  // 0 free, 1 file, 2 folder
 volatile pid_t g_child = 0;
 
 void on_signal(int sig) {
   if (g_child > 0) ::kill(g_child, SIGTERM);
-  for (int i = 0; i < kSlots; ++i)
-    if (g_kind[i] == 1) ::unlink(g_paths[i]);
-  for (int i = 0; i < kSlots; ++i)
-    if (g_kind[i] == 2) ::rmdir(g_paths[i]);
+  nystrom::remove_temporary_paths();
   static const char msg[] = "\nnystrom: error: interrupted\n";
   [[maybe_unused]] const auto n = ::write(STDERR_FILENO, msg, sizeof msg - 1);
   std::signal(sig, SIG_DFL);
@@ -71,130 +64,17 @@ void install_signal_handlers() {
 
 std::string errno_text(int e) { return std::strerror(e); }
 
+constexpr std::size_t kPathMax = 4096;
+
 }  // namespace
-
-TempFile::TempFile(std::string path, Kind kind) : path_(std::move(path)), directory_(kind == Kind::directory) {
-  if (path_.size() >= kPathMax) return;
-  for (int i = 0; i < kSlots; ++i)
-    if (g_kind[i] == 0) {
-      std::memcpy(g_paths[i], path_.c_str(), path_.size() + 1);
-      std::atomic_signal_fence(std::memory_order_seq_cst);
-      g_kind[i] = directory_ ? 2 : 1;
-      slot_ = i;
-      break;
-    }
-}
-
-void TempFile::release() {
-  if (slot_ >= 0) g_kind[slot_] = 0;
-  slot_ = -1;
-  path_.clear();
-}
-
-TempFile::~TempFile() {
-  if (!path_.empty()) (directory_ ? ::rmdir(path_.c_str()) : ::unlink(path_.c_str()));
-  release();
-}
 
 void set_signal_child(pid_t pid) { g_child = pid; }
 
 // ---------------------------------------------------------------------------------------------------------
 // Output files.
 
-namespace {
-
-void write_all(int fd, const std::string& content, const std::string& path) {
-  const char* p = content.data();
-  std::size_t left = content.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      throw UsageError("cannot write '" + path + "': " + errno_text(errno));
-    }
-    p += n;
-    left -= static_cast<std::size_t>(n);
-  }
-}
-
-bool under_system_folder(const std::string& path) {
-  return path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
-}
-
-// The final path that a chain of symbolic links names (the last component may not exist yet).
-std::string follow_links(std::string path) {
-  for (int hops = 0; hops < 40; ++hops) {
-    struct stat st {};
-    if (::lstat(path.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return path;
-    std::string buf(kPathMax, '\0');
-    const ssize_t n = ::readlink(path.c_str(), buf.data(), buf.size() - 1);
-    if (n < 0) throw UsageError("cannot write '" + path + "': " + errno_text(errno));
-    buf.resize(static_cast<std::size_t>(n));
-    if (!buf.empty() && buf[0] == '/') {
-      path = buf;
-    } else {
-      const std::filesystem::path p(path);
-      path = ((p.has_parent_path() ? p.parent_path() : std::filesystem::path(".")) / buf).string();
-    }
-  }
-  throw UsageError("cannot write '" + path + "': too many levels of symbolic links");
-}
-
-}  // namespace
-
 void write_file_atomic(const std::string& path, const std::string& content) {
-  if (path.empty()) throw UsageError("empty output file name");
-  struct stat st {};
-  const bool exists = ::stat(path.c_str(), &st) == 0;
-  if (exists && S_ISDIR(st.st_mode)) throw UsageError("cannot write '" + path + "': it is a folder");
-  if ((exists && !S_ISREG(st.st_mode)) || (exists && under_system_folder(path))) {
-    // FIFO, device, terminal, /dev/stdout: written in place (appending, so that a /dev/stdout that is a
-    // regular file keeps what the program printed before).
-    const int fd = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC | (S_ISREG(st.st_mode) ? O_APPEND : 0));
-    if (fd < 0) throw UsageError("cannot write '" + path + "': " + errno_text(errno));
-    try {
-      write_all(fd, content, path);
-    } catch (...) {
-      ::close(fd);
-      throw;
-    }
-    if (::close(fd) != 0) throw UsageError("cannot write '" + path + "': " + errno_text(errno));
-    return;
-  }
-  const std::string target = follow_links(path);
-  namespace fs = std::filesystem;
-  const fs::path tp(target);
-  const fs::path dir = tp.has_parent_path() ? tp.parent_path() : fs::path(".");
-  if (tp.filename().empty() || tp.filename() == "." || tp.filename() == "..")
-    throw UsageError("cannot write '" + path + "': not a file name");
-  struct stat dst {};
-  if (::stat(dir.c_str(), &dst) != 0 || !S_ISDIR(dst.st_mode))
-    throw UsageError("cannot write '" + path + "': folder '" + dir.string() + "' does not exist");
-  std::string tmpl = (dir / ("." + tp.filename().string() + ".tmp.XXXXXX")).string();
-  if (tmpl.size() >= kPathMax) throw UsageError("cannot write '" + path + "': the path is too long");
-  const int fd = ::mkstemp(tmpl.data());
-  if (fd < 0) throw UsageError("cannot write '" + path + "': " + errno_text(errno));
-  TempFile tmp(tmpl);
-  // mkstemp creates mode 0600: give the file the mode of the one it replaces, or the default of a new file.
-  mode_t mode = 0;
-  if (exists) {
-    mode = st.st_mode & 07777;
-  } else {
-    const mode_t mask = ::umask(0);
-    ::umask(mask);
-    mode = 0666 & ~mask;
-  }
-  ::fchmod(fd, mode);
-  try {
-    write_all(fd, content, path);
-  } catch (...) {
-    ::close(fd);
-    throw;
-  }
-  if (::close(fd) != 0) throw UsageError("cannot write '" + path + "': " + errno_text(errno));
-  if (::rename(tmpl.c_str(), target.c_str()) != 0)
-    throw UsageError("cannot write '" + path + "': " + errno_text(errno));
-  tmp.release();
+  nystrom::write_file_atomic(path, content, {.streams = true, .follow_links = true});
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -516,17 +396,7 @@ void plot_loglog(const std::string& png_path, const std::string& title, const st
 
 void plot_xy(const std::string& png_path, const std::string& title, const std::string& xlabel,
              const std::string& ylabel, const std::vector<Series>& series, const PlotAxes& axes) {
-  namespace fs = std::filesystem;
-  if (png_path.empty()) throw UsageError("empty plot file name");
-  {
-    struct stat st {};
-    if (::stat(png_path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-      throw UsageError("cannot write '" + png_path + "': it is a folder");
-    const fs::path target(png_path);
-    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
-      throw UsageError("cannot write '" + png_path + "': folder '" + dir.string() + "' does not exist");
-  }
+  check_plot_target(png_path);
   std::ostringstream script;
   script << "set terminal pngcairo size 900,650 enhanced font 'Sans,11'\n"
          << "set output 'plot.png'\n"
@@ -570,6 +440,24 @@ void plot_xy(const std::string& png_path, const std::string& title, const std::s
   for (std::size_t i = 0; i < plots.size(); ++i) script << (i ? ", \\\n     " : "") << plots[i];
   script << "\n";
 
+  render_png(png_path, script.str());
+}
+
+void check_plot_target(const std::string& png_path) {
+  namespace fs = std::filesystem;
+  if (png_path.empty()) throw UsageError("empty plot file name");
+  struct stat st {};
+  if (::stat(png_path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw UsageError("cannot write '" + png_path + "': it is a folder");
+  const fs::path target(png_path);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+    throw UsageError("cannot write '" + png_path + "': folder '" + dir.string() + "' does not exist");
+}
+
+void render_png(const std::string& png_path, const std::string& script) {
+  namespace fs = std::filesystem;
+  check_plot_target(png_path);
   const char* tmp_env = std::getenv("TMPDIR");
   std::string tmpl = (fs::path(tmp_env && *tmp_env == '/' ? tmp_env : "/tmp") / "nystrom-plot.XXXXXX").string();
   if (tmpl.size() >= kPathMax - 32 || !::mkdtemp(tmpl.data()))
@@ -579,7 +467,7 @@ void plot_xy(const std::string& png_path, const std::string& title, const std::s
   TempFile script_file(tmpl + "/plot.gp"), png_file(tmpl + "/plot.png"), log_file(tmpl + "/gnuplot.log");
   {
     std::ofstream out(script_file.path(), std::ios::binary);
-    out << script.str();
+    out << script;
     out.flush();
     if (!out) throw UsageError("cannot write the plot script in '" + tmpl + "'");
   }

@@ -31,6 +31,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "nystrom/core/files.hpp"
+
 namespace nystrom::cli {
 
 struct UsageError : std::invalid_argument {
@@ -97,24 +99,9 @@ CLI::Validator range_check(double lo, double hi);
 /// Relative cost of one force evaluation in a scalar type (double 1; measured ratios of bench_precision).
 double precision_cost(const std::string& precision);
 
-/// A temporary file or folder removed when this object goes, and also by the SIGINT/SIGTERM handler.
-class TempFile {
- public:
-  TempFile() = default;
-  enum class Kind : unsigned char { file, directory };
-  explicit TempFile(std::string path, Kind kind = Kind::file);
-  TempFile(const TempFile&) = delete;
-  TempFile& operator=(const TempFile&) = delete;
-  ~TempFile();
-  const std::string& path() const { return path_; }
-  /// The file was renamed into place: nothing to remove.
-  void release();
-
- private:
-  std::string path_;
-  int slot_ = -1;
-  bool directory_ = false;
-};
+/// A temporary file or folder removed when this object goes, and also by the SIGINT/SIGTERM handler
+/// (nystrom::TemporaryPath, core/files.hpp: the library's own temporary files are removed by it too).
+using TempFile = nystrom::TemporaryPath;
 
 /// The child process that the signal handler terminates too (gnuplot); 0: none.
 void set_signal_child(pid_t pid);
@@ -125,10 +112,12 @@ struct Registrar {
   }
 };
 
-/// Writes `content` to `path`. A regular file (or a new path) is replaced atomically: a temporary file in the
-/// same folder, then rename; a symbolic link is followed and its target replaced in the target's folder;
-/// anything else (FIFO, device, /dev/stdout, a path under /dev or /proc) is written in place. Refuses an empty
-/// path and a folder; errors carry the system's reason.
+/// Writes a result file `content` to `path` with the library's writer (nystrom::write_file_atomic,
+/// core/files.hpp). A regular file (or a new path) is replaced atomically: a unique temporary file in the
+/// same folder, fsync, then rename; a symbolic link is followed and its target replaced in the target's
+/// folder; anything else (FIFO, device, /dev/stdout, a path under /dev or /proc) is written in place.
+/// Refuses an empty path and a folder; errors carry the system's reason. (Checkpoints are stricter:
+/// write_checkpoint_text refuses links and anything but a regular file.)
 void write_file_atomic(const std::string& path, const std::string& content);
 
 /// What a parsed number must be: finite, or finite and positive.
@@ -183,6 +172,14 @@ struct PlotAxes {
 /// only printable ASCII without double quotes, backslashes, backquotes, '@' and '$' (others become '?').
 void plot_loglog(const std::string& png_path, const std::string& title, const std::string& xlabel,
                  const std::string& ylabel, const std::vector<Series>& series);
+
+/// Refuses (UsageError) an empty plot file name, a folder, and a name in a folder that does not exist.
+void check_plot_target(const std::string& png_path);
+
+/// Runs gnuplot on `script`, which must draw to `set output 'plot.png'` and hold its data inline (datablocks),
+/// in a private temporary folder (no shell; the folder, its files and gnuplot itself are removed or
+/// terminated on SIGINT/SIGTERM), then writes the picture to png_path with write_file_atomic.
+void render_png(const std::string& png_path, const std::string& script);
 
 /// The same with a choice of linear or logarithmic axes.
 void plot_xy(const std::string& png_path, const std::string& title, const std::string& xlabel,

@@ -2,16 +2,12 @@
 //  [--imaginary-time [--converge TOL]] [--x0 1] [--p0 0] [--initial-file FILE] [--g 0]
 //  [--precision double|long-double] [--json] [--plot FILE.png]`
 #include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <complex>
 #include <cstdint>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -26,8 +22,6 @@
 #ifdef NYSTROM_HAVE_MPI
 #include "nystrom/quantum/fftw_mpi.hpp"
 #endif
-
-extern char** environ;
 
 namespace {
 
@@ -96,26 +90,10 @@ class MpiSession {
   int rank_ = 0, size_ = 1;
 };
 
-/// The text of a regular file of at most max_bytes bytes (a directory, a FIFO or a device is refused: reading
-/// one could block or never end).
+/// The text of a regular file of at most max_bytes bytes (nystrom::read_input_file: a directory, a FIFO or a
+/// device is refused, since reading one could block or never end).
 std::string read_bounded(const std::string& path, const std::string& flag, std::uintmax_t max_bytes) {
-  std::error_code ec;
-  const auto st = std::filesystem::status(path, ec);
-  if (path.empty() || ec || !std::filesystem::exists(st)) throw UsageError("cannot read " + flag + " '" + path + "'");
-  if (!std::filesystem::is_regular_file(st))
-    throw UsageError("cannot read " + flag + " '" + path + "': not a regular file");
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) throw UsageError("cannot read " + flag + " '" + path + "'");
-  if (size > max_bytes)
-    throw UsageError(flag + " '" + path + "' has " + std::to_string(size) + " bytes, more than the " +
-                     std::to_string(max_bytes) + " this grid allows");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UsageError("cannot read " + flag + " '" + path + "'");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (in.bad() || static_cast<std::uintmax_t>(in.gcount()) != size)
-    throw UsageError("cannot read " + flag + " '" + path + "'");
-  return text;
+  return nystrom::read_input_file<UsageError>(path, flag, static_cast<std::size_t>(max_bytes));
 }
 
 /// The most bytes a file of values for `points` grid points may have: 128 per point (two numbers of 17
@@ -124,8 +102,9 @@ std::uintmax_t file_bound(std::size_t points) { return 128 * static_cast<std::ui
 
 /// The potential's values from a text file: numbers separated by white space, `#` to the end of a line a
 /// comment, one per grid point in row-major order (last axis fastest), at x_i = -L/2 + i L/n.
+/// A regular file of at most file_bound(points) bytes (nystrom::read_input_file).
 std::vector<double> read_potential_file(const std::string& path, std::size_t points) {
-  std::istringstream in(read_bounded(path, "--potential-file", file_bound(points)));
+  std::istringstream in(nystrom::read_input_file<UsageError>(path, "--potential-file", file_bound(points)));
   std::vector<double> v;
   std::string line;
   for (long number = 1; std::getline(in, line); ++number) {
@@ -182,64 +161,21 @@ std::vector<double> parse_vector(const std::string& text, const std::string& wha
   return v;
 }
 
-/// Runs gnuplot on a script and data of fixed names in a fresh temporary folder (no shell, no user string
-/// in the script), then moves the picture to `target` (copied next to it first, so a failure leaves any
-/// existing file untouched).
+/// Draws <x_1>(t) (or the energy) and the norm with gnuplot: the data inline in the script, nothing of the
+/// user's in it; the picture is written as every result file of the tool (nystrom::cli::render_png).
 void plot_samples(const std::string& target, const QuantumResult& r, bool imaginary) {
-  namespace fs = std::filesystem;
-  if (target.empty()) throw UsageError("empty plot file name");
-  const fs::path out(target);
-  const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir)) throw UsageError("cannot write '" + target + "': folder does not exist");
-  std::string tmpl = (fs::temp_directory_path() / "nystrom-quantum-XXXXXX").string();
-  if (!::mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary folder for the plot");
-  const fs::path tmp(tmpl);
-  std::error_code ec;
-  struct Cleanup {
-    fs::path p;
-    ~Cleanup() {
-      std::error_code e;
-      fs::remove_all(p, e);
-    }
-  } cleanup{tmp};
-  {
-    std::ofstream data(tmp / "data.txt");
-    data.precision(17);
-    for (const auto& s : r.samples)
-      data << s.time << " " << (imaginary ? s.energy : s.mean_x.at(0)) << " " << s.norm << "\n";
-  }
-  {
-    std::ofstream script(tmp / "plot.gp");
-    script << "set terminal pngcairo size 900,600\nset output 'out.png'\nset grid\n"
-           << "set xlabel '" << (imaginary ? "imaginary time" : "time") << "'\n"
-           << "set ylabel '" << (imaginary ? "energy" : "<x_1>") << "'\nset y2label 'norm'\nset y2tics\n"
-           << "plot 'data.txt' using 1:2 with lines lw 2 title '" << (imaginary ? "energy" : "<x_1>")
-           << "', 'data.txt' using 1:3 axes x1y2 with lines title 'norm'\n";
-  }
-  std::string prog = "gnuplot", script = "plot.gp";
-  char* argv[] = {prog.data(), script.data(), nullptr};
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
-  // gnuplot reads and writes relative to its working folder: run it in the temporary folder
-  const fs::path cwd = fs::current_path();
-  fs::current_path(tmp);
-  pid_t pid = 0;
-  const int rc = ::posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
-  fs::current_path(cwd);
-  posix_spawn_file_actions_destroy(&actions);
-  int status = 0;
-  if (rc != 0 || ::waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
-      !fs::exists(tmp / "out.png"))
-    throw std::runtime_error("gnuplot failed to draw '" + target + "' (is gnuplot installed?)");
-  const fs::path staged = dir / ("." + out.filename().string() + ".tmp." + std::to_string(::getpid()));
-  fs::copy_file(tmp / "out.png", staged, fs::copy_options::overwrite_existing, ec);
-  if (!ec) fs::rename(staged, out, ec);
-  if (ec) {
-    fs::remove(staged, ec);
-    throw std::runtime_error("cannot write '" + target + "'");
-  }
+  std::ostringstream script;
+  script.precision(17);
+  script << "set terminal pngcairo size 900,600\nset output 'plot.png'\nset grid\n"
+         << "set xlabel '" << (imaginary ? "imaginary time" : "time") << "'\n"
+         << "set ylabel '" << (imaginary ? "energy" : "<x_1>") << "'\nset y2label 'norm'\nset y2tics\n"
+         << "$data << EOD\n";
+  for (const auto& s : r.samples)
+    script << s.time << " " << (imaginary ? s.energy : s.mean_x.at(0)) << " " << s.norm << "\n";
+  script << "EOD\n"
+         << "plot $data using 1:2 with lines lw 2 title '" << (imaginary ? "energy" : "<x_1>")
+         << "', $data using 1:3 axes x1y2 with lines title 'norm'\n";
+  nystrom::cli::render_png(target, script.str());
 }
 
 template <class R>
@@ -371,6 +307,7 @@ nystrom::cli::Registrar reg(
         nystrom::cli::parse_double(o->g, "--g");
         if (o->precision != "double" && o->precision != "long-double")
           throw UsageError("--precision must be double or long-double, got '" + o->precision + "'");
+        if (!o->plot.empty()) nystrom::cli::check_plot_target(o->plot);
         const MpiSession mpi;
         const QuantumResult r = o->precision == "double" ? run<double>(*o, mpi) : run<long double>(*o, mpi);
         if (mpi.rank() != 0) return 0;

@@ -129,8 +129,8 @@ SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq,
       throw UsageError("--checkpoint-at must be a finite time >= 0");
     opt.checkpoint_at = sreq.checkpoint_at;
     const std::string file = sreq.checkpoint;
-    // as every result file: atomically, its temporary file removed on SIGINT/SIGTERM too
-    opt.on_checkpoint = [file](const std::string& text) { write_file_atomic(file, text); };
+    // atomically, its temporary file removed on SIGINT/SIGTERM too; a link or a non-regular file is refused
+    opt.on_checkpoint = [file](const std::string& text) { write_checkpoint_text(file, text); };
   }
   const auto w0 = std::chrono::steady_clock::now();
   Solution<V2> sol;

@@ -1,7 +1,8 @@
 // Hostile input to the command-line tool: a table of malformed invocations across every subcommand, each of
 // which must exit with status 2 and exactly one stderr line "nystrom: error: ..." (printable ASCII only), create
 // no file and leave no temporary file; the plot-name injection; output paths that are symbolic links, FIFOs
-// and folders; SIGTERM during a long run. The tool is found through NYSTROM_BIN (set by CTest) and started
+// and folders; SIGTERM during a long run; input files that are devices, FIFOs or folders; corrupted checkpoints
+// and checkpoint targets that are not regular files. The tool is found through NYSTROM_BIN (set by CTest) and started
 // without a shell, so arguments reach it byte for byte.
 #include <gtest/gtest.h>
 
@@ -13,6 +14,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -517,5 +520,155 @@ TEST(CliHostile, SigintAfterACheckpointKeepsItWhole) {
   const Result r = run(
       dir, {"run", "--restart", (dir / "cp.txt").string(), "--steps-per-period", "10000", "--periods", "1", "--json"});
   EXPECT_EQ(r.code, 0) << r.err;
+  fs::remove_all(dir);
+}
+
+// Runs the tool with a limit: a run that has not ended within `limit` is killed and reported as -1 (it hung).
+Result run_limited(const fs::path& dir, const std::vector<std::string>& args,
+                   std::chrono::seconds limit = std::chrono::seconds(60)) {
+  const pid_t pid = start(dir, args);
+  Result r;
+  r.code = wait_or_kill(pid, limit);
+  r.out = slurp(dir / "stdout.txt");
+  r.err = slurp(dir / "stderr.txt");
+  return r;
+}
+
+TEST(CliHostile, InputFilesThatAreNotRegularFilesAreRefusedAtOnce) {
+  const auto dir = work_dir();
+  const auto fifo = (dir / "pipe").string();  // no writer ever opens it
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"run", "--restart", "/dev/zero"}, "it is a device"},
+      {{"run", "--method", "M8", "--restart", "/dev/zero"}, "it is a device"},
+      {{"run", "--method", "M8", "--restart", fifo}, "it is a FIFO"},
+      {{"run", "--method", "M8", "--restart", dir.string()}, "it is a folder"},
+      {{"run", "--method", "file:/dev/zero"}, "it is a device"},
+      {{"run", "--method", "file:" + fifo}, "it is a FIFO"},
+      {{"coeffs", "file:/dev/zero"}, "it is a device"},
+      {{"run", "--problem", "nbody", "--method", "VV", "--ic", "/dev/zero"}, "it is a device"},
+      {{"run", "--problem", "nbody", "--method", "VV", "--ic", fifo}, "it is a FIFO"},
+      {{"quantum", "--grid", "8", "--steps", "2", "--potential-file", "/dev/zero"}, "it is a device"},
+      {{"quantum", "--grid", "8", "--steps", "2", "--potential-file", fifo}, "it is a FIFO"},
+  };
+  for (const auto& [args, why] : cases) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Result r = run_limited(dir, args);
+    const std::string what = joined(args);
+    EXPECT_NE(r.code, -1) << what << ": it did not end";
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(30)) << what;
+    expect_refused(r, what);
+    EXPECT_NE(r.err.find(why), std::string::npos) << what << ": " << r.err;
+  }
+  fs::remove_all(dir);
+}
+
+namespace {
+
+// The FNV-1a 64 checksum line of a checkpoint's content (computed here, independently of the tool).
+std::string rechecksum(const std::string& text) {
+  const std::string body = text.substr(0, text.rfind("checksum "));
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : body) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "checksum fnv1a64 %016llx\n", static_cast<unsigned long long>(h));
+  return body + buf;
+}
+
+std::string replace_line(const std::string& text, const std::string& key, const std::string& line) {
+  const auto a = text.find("\n" + key + " ");
+  const auto b = text.find('\n', a + 1);
+  return text.substr(0, a + 1) + line + text.substr(b);
+}
+
+}  // namespace
+
+TEST(CliHostile, CorruptedCheckpointsAreRefused) {
+  const auto dir = work_dir();
+  const std::vector<std::string> m8 = {"run", "--method", "M8", "--steps-per-period", "1000", "--periods", "2"};
+  auto with = [](std::vector<std::string> a, const std::vector<std::string>& more) {
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  };
+  ASSERT_EQ(run(dir, with(m8, {"--checkpoint", "cp", "--checkpoint-at", "1"})).code, 0);
+  const std::string good = slurp(dir / "run" / "cp");
+  ASSERT_NE(good.find("\ncarry 4 "), std::string::npos) << good;
+  auto restart = [&](const std::string& text, const std::string& what) {
+    std::ofstream(dir / "run" / "bad", std::ios::binary) << text;
+    const Result r = run_limited(dir, with(m8, {"--restart", "bad", "--json"}));
+    expect_refused(r, what);
+    EXPECT_NE(r.err.find("checkpoint"), std::string::npos) << what << ": " << r.err;
+    EXPECT_EQ(r.out, "") << what;
+  };
+  std::string bad = good;
+  const auto q = bad.find("\nstate 4 0x") + 11;
+  bad[q] = bad[q] == '1' ? '2' : '1';
+  restart(bad, "a hex digit of q changed");
+  bad = good;
+  const auto si = bad.find("\nstep_index ") + 12;
+  bad[si] = static_cast<char>(bad[si] == '9' ? '8' : bad[si] + 1);
+  restart(bad, "step_index changed");
+  bad = good;
+  const auto t = bad.find("\nt 0x") + 6;
+  bad[t] = bad[t] == '8' ? '9' : '8';
+  restart(bad, "t changed");
+  bad = good;
+  bad.insert(bad.find("\nt 0x") + 5, 1, '\0');
+  restart(bad, "a NUL byte in t");
+  bad = good;
+  const auto c = bad.find("\ncarry ");
+  bad.erase(c, bad.find('\n', c + 1) - c);
+  restart(bad, "the carry line deleted");
+  restart(rechecksum(bad), "the carry line deleted, checksum recomputed");
+  // the checkpoint as written restarts
+  EXPECT_EQ(run(dir, with(m8, {"--restart", "cp"})).code, 0);
+
+  // GBS: an order of 100000000 columns and a NaN state; an order beyond the integrator's columns with a state
+  // that reads: refused (the first crashed the restart), not a signal
+  const std::vector<std::string> gbs = {"run", "--method", "GBS", "--tol", "1e-10", "--periods", "2"};
+  ASSERT_EQ(run(dir, with(gbs, {"--checkpoint", "g", "--checkpoint-at", "1"})).code, 0);
+  const std::string g = slurp(dir / "run" / "g");
+  for (const auto& [text, why] : std::vector<std::pair<std::string, std::string>>{
+           {rechecksum(
+                replace_line(replace_line(g, "columns", "columns 100000000"), "state", "state 4 nan nan nan nan")),
+            "malformed checkpoint"},
+           {rechecksum(replace_line(g, "columns", "columns 25")), "columns) is outside 2..11"}}) {
+    std::ofstream(dir / "run" / "bad", std::ios::binary) << text;
+    const Result r = run_limited(dir, with(gbs, {"--restart", "bad"}));
+    expect_refused(r, why);
+    EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CliHostile, CheckpointTargetsThatAreNotRegularFilesAreRefused) {
+  const auto dir = work_dir();
+  const std::vector<std::string> m8 = {"run", "--method",        "M8", "--steps-per-period", "1000", "--periods",
+                                       "2",   "--checkpoint-at", "1",  "--checkpoint"};
+  auto with = [](std::vector<std::string> a, const std::string& target) {
+    a.push_back(target);
+    return a;
+  };
+  ASSERT_EQ(::mkfifo((dir / "run" / "pipe").c_str(), 0600), 0);
+  std::ofstream(dir / "victim") << "precious\n";
+  fs::create_symlink(dir / "victim", dir / "run" / "link");
+  fs::create_directories(dir / "run" / "folder");
+  for (const auto& [target, why] : std::vector<std::pair<std::string, std::string>>{{"pipe", "it is a FIFO"},
+                                                                                    {"link", "it is a symbolic link"},
+                                                                                    {"folder", "it is a folder"},
+                                                                                    {"/dev/null", "it is a device"}}) {
+    const Result r = run_limited(dir, with(m8, target));
+    expect_refused(r, target);
+    EXPECT_NE(r.err.find("cannot write the checkpoint file '" + target + "': " + why), std::string::npos) << r.err;
+  }
+  struct stat st {};
+  ASSERT_EQ(::lstat((dir / "run" / "pipe").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_TRUE(fs::is_symlink(dir / "run" / "link"));
+  EXPECT_EQ(slurp(dir / "victim"), "precious\n");
+  EXPECT_EQ(listing(dir / "run"), (std::set<std::string>{"pipe", "link", "folder"}));
   fs::remove_all(dir);
 }

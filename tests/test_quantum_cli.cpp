@@ -2,7 +2,9 @@
 // bad input (exit code 2, one line `nystrom: error: ...`). The tool is found through NYSTROM_BIN.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,8 +16,10 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -157,6 +161,71 @@ TEST(QuantumCli, PlotWritesAPng) {
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string head = slurp(png).substr(0, 4);
   EXPECT_EQ(head, "\x89PNG");
+}
+
+// --plot is written as every result file of the tool (sweep --plot, --csv): a link's target is replaced and the
+// link kept, a FIFO and a device are written in place (never replaced by a regular file), a failure says why,
+// and no temporary file is left beside the target or in TMPDIR.
+TEST(QuantumCli, PlotTargetsAreWrittenAsEveryResultFile) {
+  const auto dir = temp_dir() / "plots";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "data");
+  std::filesystem::create_directories(dir / "tmp");
+  const std::string quantum = "quantum --grid 64 --steps 20 --method PV --plot ";
+  const std::string env = "env TMPDIR=" + (dir / "tmp").string();
+  // a link: its target replaced, the link kept
+  std::ofstream(dir / "data" / "target.png") << "old";
+  std::filesystem::create_symlink(dir / "data" / "target.png", dir / "link.png");
+  const auto l = run(quantum + (dir / "link.png").string(), temp_dir(), env);
+  ASSERT_EQ(l.code, 0) << l.err;
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "link.png"));
+  EXPECT_EQ(slurp(dir / "data" / "target.png").substr(0, 4), "\x89PNG");
+  // a FIFO: written in place, still a FIFO
+  const auto fifo = dir / "pipe.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string got;
+  std::thread reader([&] { got = slurp(fifo); });
+  const auto f = run(quantum + fifo.string(), temp_dir(), env);
+  // should the tool not have opened the FIFO, a writer of no bytes ends the reader
+  const int unblock = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+  if (unblock >= 0) ::close(unblock);
+  reader.join();
+  ASSERT_EQ(f.code, 0) << f.err;
+  EXPECT_EQ(got.substr(0, 4), "\x89PNG");
+  struct stat st {};
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the FIFO was replaced";
+  // a device node (as root: /dev/full's numbers): written in place, which fails with the device's reason
+  const auto node = dir / "node.png";
+  if (::mknod(node.c_str(), S_IFCHR | 0600, ::makedev(1, 7)) == 0) {
+    const auto d = run(quantum + node.string(), temp_dir(), env);
+    EXPECT_EQ(d.code, 2);
+    EXPECT_NE(d.err.find("No space left on device"), std::string::npos) << d.err;
+    ASSERT_EQ(::lstat(node.c_str(), &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode)) << "the device node was replaced";
+    std::filesystem::remove(node);
+  }
+  // a failure gives the system's reason: a name too long for the file system, and (not as root) a read-only folder
+  // (relative to the folder, so that the one-line message, at most 400 characters, holds the reason)
+  const std::string long_name = std::string(256, 'n') + ".png";
+  const auto n = run(quantum + long_name, temp_dir(), "cd " + dir.string() + " && " + env);
+  EXPECT_EQ(n.code, 2);
+  EXPECT_NE(n.err.find("File name too long"), std::string::npos) << n.err;
+  if (::geteuid() != 0) {
+    std::filesystem::create_directories(dir / "ro");
+    std::filesystem::permissions(dir / "ro", std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+    const auto r = run(quantum + (dir / "ro" / "keep.png").string(), temp_dir(), env);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("Permission denied"), std::string::npos) << r.err;
+    std::filesystem::permissions(dir / "ro", std::filesystem::perms::owner_all);
+  }
+  std::set<std::string> names;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+    names.insert(e.path().lexically_relative(dir).string());
+  std::set<std::string> expected{"data", "data/target.png", "link.png", "pipe.png", "tmp"};
+  if (::geteuid() != 0) expected.insert("ro");
+  EXPECT_EQ(names, expected);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(QuantumCli, BadInputExitsTwoWithOneLine) {

@@ -26,7 +26,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -34,6 +33,7 @@
 #include <vector>
 
 #include "nystrom/analysis/bch.hpp"
+#include "nystrom/core/files.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/method.hpp"
 
@@ -266,13 +266,11 @@ inline void validate_method_file(const MethodFile& f, const std::string& where) 
 }
 
 /// Reads, parses and validates a method file.
+/// The file must be a regular file of at most 10 MB (read_input_file, core/files.hpp: a device, FIFO or
+/// folder is refused before anything is read).
 inline MethodFile read_method_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot open method file '" + path + "'");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (ss.str().size() > 10'000'000) throw std::invalid_argument("method file '" + path + "' is too large");
-  MethodFile f = parse_method_file(ss.str(), path);
+  const std::string text = read_input_file<std::invalid_argument>(path, "method file", 10'000'000);
+  MethodFile f = parse_method_file(text, path);
   validate_method_file(f, path);
   return f;
 }

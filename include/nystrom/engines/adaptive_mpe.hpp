@@ -227,7 +227,10 @@ class AdaptiveMpeIntegrator {
   }
   /// Where the last run stopped at its observer's request (AdaptiveResumePoint, adaptive_rkn.hpp).
   const AdaptiveResumePoint<real_type>& resume_point() const { return resume_; }
-  void set_resume_point(const AdaptiveResumePoint<real_type>& p) { resume_ = p; }
+  void set_resume_point(const AdaptiveResumePoint<real_type>& p) {
+    p.check();
+    resume_ = p;
+  }
   /// The compensated-summation carries of the run (checkpoint/restart).
   Compensator<V>& compensator() { return comp_; }
 

@@ -224,6 +224,16 @@ struct AdaptiveResumePoint {
   bool last_rejected = false;
   double q_prev = 0, h_prev = 0;
   bool valid = false;
+  /// A valid point must be one an engine can have stopped at: finite t, 0 < h_want <= hmax (finite), and
+  /// a history q_prev, h_prev >= 0 (finite). Throws invalid_input otherwise (a checkpoint is refused).
+  void check() const {
+    if (!valid) return;
+    if (!is_finite_scalar(t) || !is_finite_scalar(hmax) || !(h_want > R(0)) || !(h_want <= hmax) ||
+        !std::isfinite(q_prev) || !std::isfinite(h_prev) || !(q_prev >= 0) || !(h_prev >= 0))
+      throw invalid_input(
+          "adaptive step control: the resume point needs a finite time, 0 < h_want <= hmax and a "
+          "history >= 0");
+  }
 };
 
 namespace adaptive_detail {
@@ -455,7 +465,10 @@ class AdaptiveRknIntegrator {
   }
   /// Where the last run stopped at its observer's request (valid == false: it did not stop).
   const AdaptiveResumePoint<real_type>& resume_point() const { return resume_; }
-  void set_resume_point(const AdaptiveResumePoint<real_type>& p) { resume_ = p; }
+  void set_resume_point(const AdaptiveResumePoint<real_type>& p) {
+    p.check();
+    resume_ = p;
+  }
   /// The compensated-summation carries of the run (checkpoint/restart).
   Compensator<V>& compensator() { return comp_; }
 

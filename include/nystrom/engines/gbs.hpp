@@ -141,7 +141,20 @@ class GbsIntegrator {
     bool valid = false;
   };
   const ResumePoint& resume_point() const { return resume_; }
-  void set_resume_point(const ResumePoint& p) { resume_ = p; }
+  /// A valid point must be one this integrator can have stopped at: 0 < t < span, a finite step H > 0 and
+  /// an order k of 2 to max_columns - 1 columns (invalid_input otherwise: a checkpoint is refused).
+  void set_resume_point(const ResumePoint& p) {
+    if (p.valid) {
+      const int km = opt_.max_columns;
+      if (p.k < 2 || p.k > km - 1)
+        throw invalid_input("GBS: the order of the resume point (" + std::to_string(p.k) + " columns) is outside 2.." +
+                            std::to_string(km - 1) + " of this integrator");
+      if (!is_finite_scalar(p.H) || !(p.H > real_type(0)) || !is_finite_scalar(p.span) || !is_finite_scalar(p.t) ||
+          !(p.t > real_type(0)) || !(p.t < p.span))
+        throw invalid_input("GBS: the resume point needs 0 < t < span and a finite step > 0");
+    }
+    resume_ = p;
+  }
   /// The counters (a restart from a checkpoint continues them).
   void set_counters(long force_evals, long accepted, long rejected) {
     evals_ = force_evals;

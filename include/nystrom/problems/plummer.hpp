@@ -20,8 +20,8 @@
 //   m, x, y, z, vx, vy, vz
 // separated by commas (or blanks). Blank lines and lines starting with '#' are ignored; a first line
 // "m,x,y,z,vx,vy,vz" is accepted as a header. Masses must be positive, all numbers finite.
-// save_particles writes 17 significant digits (the file reads back bit for bit), atomically (a temporary
-// file in the same folder, then rename).
+// save_particles writes 17 significant digits (the file reads back bit for bit), atomically (write_file_atomic,
+// core/files.hpp). load_particles reads a regular file of at most 64 MiB (read_input_file).
 #pragma once
 
 #include <algorithm>
@@ -32,16 +32,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
+#include "nystrom/core/files.hpp"
 #include "nystrom/problems/nbody.hpp"
 
 namespace nystrom {
@@ -147,8 +144,7 @@ ParticleSet<T> plummer_sphere(std::size_t n, std::uint64_t seed, const PlummerOp
 /// Reads a particle file (see the top of the file). Throws std::invalid_argument with the line number.
 template <class T = double>
 ParticleSet<T> load_particles(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot open particle file '" + path + "'");
+  std::istringstream in(read_input_file<std::invalid_argument>(path, "particle file"));
   std::vector<std::array<double, 7>> rows;
   std::string line;
   long lineno = 0;
@@ -190,7 +186,6 @@ ParticleSet<T> load_particles(const std::string& path) {
     if (!(row[0] > 0.0)) throw std::invalid_argument(where + "mass must be positive");
     rows.push_back(row);
   }
-  if (in.bad()) throw std::invalid_argument("error reading particle file '" + path + "'");
   if (rows.size() < 2)
     throw std::invalid_argument("particle file '" + path + "' must hold at least 2 particles, found " +
                                 std::to_string(rows.size()));
@@ -209,27 +204,13 @@ ParticleSet<T> load_particles(const std::string& path) {
   return p;
 }
 
-/// Writes text to path atomically: a temporary file in the same folder, then rename.
+/// Writes text to path atomically (write_file_atomic, core/files.hpp: a unique temporary file in the same
+/// folder, fsync, rename; a folder, device, FIFO or symbolic link is refused). Throws std::invalid_argument.
 inline void write_text_atomic(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path tmp = target.parent_path() / (target.filename().string() + ".tmp." + std::to_string(::getpid()));
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::invalid_argument("cannot write '" + path + "'");
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw std::invalid_argument("error writing '" + path + "'");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::invalid_argument("cannot write '" + path + "': rename failed");
+  try {
+    write_file_atomic(path, text);
+  } catch (const error& e) {
+    throw std::invalid_argument(e.what());
   }
 }
 

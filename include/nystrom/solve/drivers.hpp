@@ -436,6 +436,7 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
   R tprev = tstart;
   // The user's time at the end of the j-th step (the last one ends on t1).
   auto step_end = [&](long j) -> R { return j == n ? prob.t1 : sgn_mul(dir, R(tau0 + h * R(j))); };
+  if (resume && resume->t != step_end(k0)) throw invalid_input("checkpoint: its time is not that of its step index");
   // A failed run reports the forces evaluated up to the failure.
   struct CountOnExit {
     Solution<V>& sol;
