@@ -1,11 +1,13 @@
 // The Python module's binding of solve() (nystrom/solve.hpp): the one driver runs every integration
 // that nystrom.solve asks for. This header converts a request built from Python arguments into a
-// SecondOrderProblem, events and SolveOptions, runs solve() (with the GIL released when neither the
-// force nor an event calls into Python) and converts the Solution back: arrays of doubles, the final
-// state in full working precision as decimal strings, and sol(t) kept as a DenseSolution.
+// SecondOrderProblem, events and SolveOptions, runs solve() with the GIL released and converts the
+// Solution back: arrays of doubles, the final state in full working precision as decimal strings, and
+// sol(t) kept as a DenseSolution.
 //
-// Python callables (the force, events, progress) run with the GIL held; an exception they raise travels
-// through solve() as py::error_already_set and reaches the caller as the original Python exception.
+// Python callables (the force, events, progress) take the GIL for their call only; an exception they raise
+// travels through solve() as py::error_already_set and reaches the caller as the original Python exception.
+// The run itself holds no GIL, so that the library locks it takes (method_data_for, MPFR precision) are
+// never waited for with the GIL held.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -176,7 +178,9 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
 
   std::vector<Event<V>> events;
   for (const auto& e : r.events) {
-    auto g = [fn = e.g, n](const R& t, const V& q, const V& v) -> R {
+    // fn is borrowed from the request (alive for the run): copies of g touch no reference count.
+    auto g = [fn = py::handle(e.g), n](const R& t, const V& q, const V& v) -> R {
+      py::gil_scoped_acquire hold;
       py::array_t<double> qa(static_cast<py::ssize_t>(n)), va(static_cast<py::ssize_t>(n));
       for (std::size_t i = 0; i < n; ++i) {
         qa.mutable_at(i) = to_double(q[i]);
@@ -187,27 +191,19 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
     events.push_back({e.name, std::move(g), e.direction, e.terminal});
   }
 
-  // Python runs only in the heartbeat: the GIL is released for the whole run. Not in MPFR, whose run holds
-  // the process-wide precision lock: a thread waiting for that lock with the GIL would block this run's
-  // heartbeat.
-  const bool release = !python_force && events.empty() && mpfr_bits == 0;
+  // The GIL is released for the whole run; Python runs at every step with a Python force or events, or the
+  // steps are slow (MPFR).
+  const bool python_every_step = python_force || !events.empty() || mpfr_bits != 0;
   SolveOptions opt = r.options;
   opt.partial_on_failure = true;  // a failed run returns the states it reached, with status -1
   // Interruption checks (Ctrl-C) and progress every on_step_every steps: about 2^22 coordinate updates apart,
   // or every 64 steps when Python runs at every step anyway.
   const long work = static_cast<long>(m) * std::max(1, r.method.info.forces_per_step);
-  opt.on_step_every = release ? std::max(1L, (1L << 22) / std::max(1L, work)) : 64;
+  opt.on_step_every = python_every_step ? 64 : std::max(1L, (1L << 22) / std::max(1L, work));
   opt.on_step = [&](double t) {
-    auto beat = [&] {
-      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-      if (!r.progress.is_none()) r.progress(t);
-    };
-    if (release) {
-      py::gil_scoped_acquire hold;
-      beat();
-    } else {
-      beat();
-    }
+    py::gil_scoped_acquire hold;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (!r.progress.is_none()) r.progress(t);
   };
 
   opt.checkpoint_at = r.checkpoint_at;
@@ -237,10 +233,8 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   std::string message;
   const auto start = std::chrono::steady_clock::now();
   auto run = [&] { return from ? resume(prob, r.method, *from, opt, events) : solve(prob, r.method, opt, events); };
-  if (release) {
+  {
     py::gil_scoped_release free;
-    sol = run();
-  } else {
     sol = run();
   }
   if (sol.status == SolveStatus::terminated_by_event) {
