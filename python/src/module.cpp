@@ -206,8 +206,14 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "methods",
       [] {
+        // The catalog is built at its first use, which takes the precision lock: without the GIL.
+        const auto infos = released([] {
+          std::vector<MethodInfo> v;
+          for (const auto& d : catalog()) v.push_back(d.info);
+          return v;
+        });
         py::list out;
-        for (const auto& d : catalog()) out.append(info_dict(d.info));
+        for (const auto& info : infos) out.append(info_dict(info));
         return out;
       },
       "Every method in the catalog, as a list of dicts.");

@@ -250,18 +250,27 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   py::dict d;
   d["solve_seconds"] = seconds;
-  std::vector<double> t, q, v;
-  for (const auto& x : sol.t) t.push_back(as_double(x));
-  for (const auto& x : sol.q) append_doubles(x, n, q);
-  for (const auto& x : sol.v) append_doubles(x, n, v);
-  if (status == 1 && (t.empty() || t.back() != as_double(sol.t_final))) {  // the terminal event ends the output
-    t.push_back(as_double(sol.t_final));
-    append_doubles(sol.q_final, n, q);
-    append_doubles(sol.v_final, n, v);
-  }
-  d["t"] = py::array_t<double>(static_cast<py::ssize_t>(t.size()), t.data());
-  d["q"] = rows_array(q, t.size(), n);
-  d["v"] = rows_array(v, t.size(), n);
+  // The saved states, written once, straight into the arrays returned (every-step output: one per step).
+  const bool terminal_state =  // the terminal event ends the output
+      status == 1 && (sol.t.empty() || as_double(sol.t.back()) != as_double(sol.t_final));
+  const std::size_t rows = sol.t.size() + (terminal_state ? 1 : 0);
+  const auto nr = static_cast<py::ssize_t>(rows), nc = static_cast<py::ssize_t>(n);
+  py::array_t<double> ta(nr), qa({nr, nc}), va({nr, nc});
+  double* tp = ta.mutable_data();
+  double* qp = qa.mutable_data();
+  double* vp = va.mutable_data();
+  auto put = [&](std::size_t k, const auto& t, const V& q, const V& v) {
+    tp[k] = as_double(t);
+    for (std::size_t i = 0; i < n; ++i) {
+      qp[k * n + i] = to_double(q[i]);
+      vp[k * n + i] = to_double(v[i]);
+    }
+  };
+  for (std::size_t k = 0; k < sol.t.size(); ++k) put(k, sol.t[k], sol.q[k], sol.v[k]);
+  if (terminal_state) put(rows - 1, sol.t_final, sol.q_final, sol.v_final);
+  d["t"] = ta;
+  d["q"] = qa;
+  d["v"] = va;
   py::list hits;
   for (const auto& h : sol.events) {
     std::vector<double> hq, hv;

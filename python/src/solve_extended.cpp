@@ -15,7 +15,8 @@ py::dict solve_builtin_extended(const std::string& problem, const std::vector<do
   const SmallProblemForce force = SmallProblemForce::of(problem, params, r.q0.size());
   // MPFR: the run holds the process-wide precision lock (recursive) for its whole length. It is taken here
   // with the GIL released, so that this thread never waits for it with the GIL held; dispatch_precision's
-  // own scope below then finds it held by this thread.
+  // own scope below then finds it held by this thread. The run's heartbeat (Ctrl-C, progress) and the result's
+  // conversion take the GIL while the lock is held: no thread waits for the lock with the GIL, so they get it.
   std::optional<MpfrPrecision> hold;
   if (precision.rfind("mpfr:", 0) == 0) {
     py::gil_scoped_release free;
