@@ -521,6 +521,7 @@ ParsedApp make_app() {
   p.app = std::make_unique<CLI::App>(
       "nystrom: high-order splitting, Runge-Kutta-Nystrom and multi-product integrators for q'' = a(q)");
   p.app->name("nystrom");
+  p.app->set_version_flag("--version", NYSTROM_VERSION, "Print the version (the CMake project version) and exit");
   p.app->require_subcommand(1);
   for (const auto& c : commands()) {
     CLI::App* sub = p.app->add_subcommand(c.name, c.help);
@@ -542,6 +543,8 @@ Invocation parse_command_line(int argc, const char* const* argv, std::ostream& h
   } catch (const CLI::CallForHelp& e) {
     return {{}, p.app->exit(e, help_out, help_out)};
   } catch (const CLI::CallForAllHelp& e) {
+    return {{}, p.app->exit(e, help_out, help_out)};
+  } catch (const CLI::CallForVersion& e) {
     return {{}, p.app->exit(e, help_out, help_out)};
   } catch (const CLI::ParseError& e) {
     throw UsageError(std::string(e.what()) + " (see nystrom --help)");

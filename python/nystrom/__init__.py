@@ -11,12 +11,15 @@ pool; ``nystrom.plot`` draws orbits, energy errors and work-precision charts.
 """
 
 import json
+import numbers
 
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
 from ._quantum import QuantumResult, quantum
 from .ensemble import ensemble
 from . import problems
+
+__version__ = _core.__version__  # the CMake project version, as `nystrom --version` prints it
 
 __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
            "problems", "ensemble", "plot"]
@@ -48,12 +51,22 @@ def coeffs(what, seq=None, order=None, n=None, sum=None, digits=20):
     if what != "mpe":
         if seq is not None or order is not None or n is not None or sum is not None:
             raise ValueError("seq, order, n and sum apply to coeffs('mpe', ...) only")
-        return _core.method_coeffs(what, int(digits))
+        return _core.method_coeffs(what, _integer("digits", digits, 1, 1000))
     given = (seq is not None) + (order is not None) + (n is not None or sum is not None)
     if given != 1:
         raise ValueError("coeffs('mpe') needs exactly one of seq, order, or n with sum")
     if seq is not None:
-        k = [int(x) for x in seq]
+        if isinstance(seq, (str, bytes)) or not hasattr(seq, "__iter__"):
+            raise TypeError(f"seq must be a sequence of integers, got {type(seq).__name__}")
+        k = []
+        for x in seq:
+            if isinstance(x, bool) or not isinstance(x, numbers.Integral):
+                raise TypeError(f"seq must be a sequence of integers, got a member of type {type(x).__name__}")
+            if x <= 0:
+                raise ValueError(f"MPE sequence members must be positive integers, got {int(x)}")
+            if x > 1_000_000:
+                raise ValueError(f"MPE sequence member too large: {int(x)}")
+            k.append(int(x))
     elif order is not None:
         if int(order) != order or order < 2 or order % 2:
             raise ValueError("order must be a positive even number")
@@ -61,9 +74,10 @@ def coeffs(what, seq=None, order=None, n=None, sum=None, digits=20):
             raise ValueError("order must be at most 400")
         k = list(range(1, order // 2 + 1))
     else:
-        if n is None or sum is None or n <= 0 or sum <= 0:
+        if n is None or sum is None:
             raise ValueError("n and sum must both be positive")
-        k = _core.optimal_mpe_sequence(int(n), int(sum))
+        n = _integer("n", n, 1, 200)  # an MPE sequence has at most 200 members
+        k = _core.optimal_mpe_sequence(n, _integer("sum", sum, n * (n + 1) // 2, 200 * 1_000_000))
     return _core.mpe_coeffs(k)
 
 
@@ -75,7 +89,18 @@ def bch(method, degree=7, basis="hall", algebra="rkn", bits=192, tolerance=0.0):
     "rkn" (q'' = a(q): [V,[V,[T,V]]] = 0) or "free"."""
     if not isinstance(method, str):
         raise TypeError(f"method must be a string, got {type(method).__name__}")
-    return json.loads(_core.bch_json(method, int(degree), str(basis), str(algebra), int(bits), float(tolerance)))
+    degree = _integer("degree", degree, 1, _core.max_lie_degree)
+    bits = _integer("bits", bits, 64, 4096)
+    return json.loads(_core.bch_json(method, degree, str(basis), str(algebra), bits, float(tolerance)))
+
+
+def _integer(name, x, lo, hi):
+    """x as an int in [lo, hi], or a one-line TypeError/ValueError (the C++ library's words for the range)."""
+    if isinstance(x, bool) or not isinstance(x, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {type(x).__name__}")
+    if not lo <= x <= hi:
+        raise ValueError(f"{name} must be between {lo} and {hi}, got {int(x)}")
+    return int(x)
 
 
 def __getattr__(name):

@@ -19,6 +19,8 @@ from .problems import Problem
 __all__ = ["solve", "OdeResult", "DenseSolution"]
 
 _NO_LIMIT = 2**62  # max_steps of a fixed-step run: its number of steps is the caller's choice
+# The C++ solve()'s error for a fixed-step method given neither h nor steps (the same words in C++, Python, CLI).
+FIXED_STEP_NEEDS = "a fixed-step method needs a positive step size h or a number of steps"
 
 
 class OdeResult(AttrDict):
@@ -189,6 +191,37 @@ def _precision(precision, bits):
     return f"mpfr:{int(bits)}"
 
 
+# Bytes per coordinate of a saved state in the C++ Solution, by working precision (MPFR: value and limbs).
+_SCALAR_BYTES = {"double": 8, "long-double": 16, "float128": 16, "dd": 16, "qd": 32}
+
+
+def _memory_bytes():
+    """The machine's physical memory in bytes, or None where the platform does not say."""
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def _check_output_memory(n_steps, what, n, precision):
+    """Refuses, before anything is allocated, a fixed-step run whose every-step output cannot fit in memory:
+    the C++ Solution, its float64 copy and the numpy arrays each hold every state (t, q, v)."""
+    mem = _memory_bytes()
+    if not mem:
+        return
+    if precision.startswith("mpfr"):
+        bits = int(precision.split(":", 1)[1]) if ":" in precision else 256
+        scalar = 32 + bits // 8
+    else:
+        scalar = _SCALAR_BYTES.get(precision, 8)
+    per_state = (1 + 2 * n) * (scalar + 2 * 8) + 2 * 40  # the Solution, two float64 copies; vector headers
+    need = (n_steps + 1) * per_state
+    if need > mem:
+        raise ValueError(f"{what}: saving every step ({n_steps + 1} states of {n} coordinates) needs about "
+                         f"{need / 1e9:.3g} GB, more than this machine's {mem / 1e9:.3g} GB of memory; give "
+                         "t_eval (the output times) or fewer steps")
+
+
 def _checkpoint_args(checkpoint, checkpoint_at, restart, t0, t1):
     """(checkpoint time or NaN, checkpoint file or '', restart file or '')."""
     if (checkpoint is None) != (checkpoint_at is None):
@@ -221,8 +254,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     Parameters
     ----------
     force : callable or nystrom.problems.Problem
-        ``force(t, q) -> array`` shaped like ``q`` (called once per force evaluation with the time of the
-        stage; exceptions propagate unchanged), or a built-in problem (runs entirely in C++ with the GIL
+        ``force(t, q) -> array`` of exactly ``q``'s shape (called once per force evaluation with the time of
+        the stage; exceptions propagate unchanged), or a built-in problem (runs entirely in C++ with the GIL
         released). The time is integrated as one more coordinate (velocity 1), exactly by every method.
     q0, v0 : array_like
         Initial positions and velocities (any shape, the same for both). Default for a built-in problem:
@@ -239,10 +272,12 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         rtol = 0 with atol > 0: absolute error control only). Adaptive methods
         (RKN pairs such as ``DP12-adaptive``, ``M<2n>-adaptive``, ``GBS``) take them; a multi-product method
         given a tolerance runs as its adaptive form (``M10`` as ``M10-adaptive``). Without h, steps, rtol
-        and atol, adaptive methods use rtol = 1e-9.
+        and atol, adaptive methods use rtol = 1e-9 and a fixed-step method is refused (ValueError: a
+        fixed-step method needs a positive step size h or a number of steps).
     t_eval : array_like
         Output times, monotone in the direction of integration, inside t_span (each a partial step of the
-        method from the step end before it). Default: every step end.
+        method from the step end before it). Default: every step end (a fixed-step run whose every state
+        cannot fit in memory is refused before it starts).
     events : callable or list of callables
         ``event(t, q, v) -> float``; a zero crossed within a step is located on partial steps of the
         method. Optional attributes ``terminal`` (stop at the first zero) and ``direction`` (>0 rising
@@ -300,8 +335,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         to_flat, from_flat = problem._to_flat, problem._from_flat
         kind, py_force = problem._kind, None
 
-        def rows(a):
-            return np.stack([from_flat(x) for x in a]) if len(a) else np.empty((0,) + tuple(shape))
+        rows = problem._rows_from_flat
     elif callable(force):
         q0 = _state("q0", q0)
         v0 = _state("v0", v0, q0.shape)
@@ -328,25 +362,35 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         raise ValueError("fixed steps (h, steps) and tolerances (rtol, atol) exclude each other")
     if isinstance(max_steps, bool) or not isinstance(max_steps, numbers.Integral) or max_steps <= 0:
         raise ValueError("max_steps must be a positive integer")
+    if max_steps > _NO_LIMIT:
+        raise ValueError(f"max_steps must be at most 2**62, got {max_steps!r}")
     rtol = None if rtol is None else _tolerance("rtol", rtol)
     atol = None if atol is None else _tolerance("atol", atol)
-    info = _core.solve_method_info(method, not fixed)
+    # Without h, steps, rtol and atol the method runs as named: a fixed-step method is refused (the C++
+    # solve()'s error), never switched to an adaptive form; a tolerance turns a multi-product method into its
+    # adaptive form.
+    tolerance = rtol is not None or atol is not None
+    info = _core.solve_method_info(method, tolerance)
     h_value, n_steps = 0.0, 0
     if fixed:
         if steps is not None:
             if isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps <= 0:
                 raise ValueError(f"steps must be a positive integer, got {steps!r}")
+            if steps > _NO_LIMIT:
+                raise ValueError(f"steps must be at most 2**62, got {steps!r}")
             n_steps = int(steps)
         else:
             h_value = _positive("h", h)
         rtol = atol = 0.0
     else:
+        if not tolerance and not info["adaptive"]:
+            raise ValueError(f"method '{info['name']}' runs with fixed steps: {FIXED_STEP_NEEDS}")
         if info["complex"]:
             raise ValueError(f"method '{info['name']}' has complex coefficients: adaptive steps need a method "
                              "with real coefficients (give h or steps)")
         if not info["adaptive"]:
-            raise ValueError(f"method '{info['name']}' takes fixed steps: give h or steps "
-                             "(or choose an adaptive method and rtol)")
+            raise ValueError(f"method '{info['name']}' runs with fixed steps: rtol and atol apply to adaptive "
+                             f"methods only; {FIXED_STEP_NEEDS}")
         if rtol is None and atol is None:
             rtol, atol = 1e-9, 0.0
         elif rtol is None:
@@ -367,6 +411,10 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
                           ([f"t1={t1.hex()}"] if n_steps else []) +
                           [f"rtol={float(rtol).hex()}", f"atol={float(atol).hex()}",
                            f"keep_complex={int(bool(keep_complex))}"])
+
+    if fixed and t_eval is None:
+        _check_output_memory(n_steps if n_steps else math.ceil(abs(t1 - t0) / h_value * (1 - 1e-12)),
+                             f"steps={n_steps}" if n_steps else f"h={h_value!r}", int(np.prod(shape)), precision)
 
     # ---- the run ---------------------------------------------------------------------------------
     bar = make_progress(progress, t0, t1)
@@ -397,9 +445,14 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.sol = None if d["sol"] is None else DenseSolution(d["sol"], rows, shape, recipe)
     if evs:
         hits = [[x for x in d["events"] if x[0] == k] for k in range(len(evs))]
+        n_flat = int(np.prod(shape))
+
+        def states(hs, j):  # (len(hs),) + shape, also for an event that never fired
+            return rows(np.array([x[j][0] for x in hs], dtype=float).reshape(len(hs), n_flat))
+
         res.t_events = [np.array([x[1] for x in hs], dtype=float) for hs in hits]
-        res.q_events = [rows(np.array([x[2][0] for x in hs]).reshape(len(hs), -1)) for hs in hits]
-        res.v_events = [rows(np.array([x[3][0] for x in hs]).reshape(len(hs), -1)) for hs in hits]
+        res.q_events = [states(hs, 2) for hs in hits]
+        res.v_events = [states(hs, 3) for hs in hits]
     else:
         res.t_events = res.q_events = res.v_events = None
     res.method = info["name"]

@@ -48,6 +48,11 @@ class Problem:
     def _from_flat(self, x):
         return np.asarray(x, dtype=float).reshape(self.shape)
 
+    def _rows_from_flat(self, a):
+        """States saved as rows of flat states, shape (k, size), as one array of shape (k,) + shape."""
+        a = np.asarray(a, dtype=float)
+        return a.reshape((a.shape[0],) + tuple(self.shape))
+
     def energy(self, q, v):
         raise NotImplementedError
 
@@ -207,6 +212,10 @@ class NBody(Problem):
 
     def _from_flat(self, x):
         return np.asarray(x, dtype=float).reshape(3, self.N).T.copy()
+
+    def _rows_from_flat(self, a):
+        a = np.asarray(a, dtype=float)
+        return np.ascontiguousarray(a.reshape(a.shape[0], 3, self.N).transpose(0, 2, 1))
 
     def energy(self, q, v):
         """Kinetic plus (softened) potential energy; q, v of shape (N, 3) or (k, N, 3)."""

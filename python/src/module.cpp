@@ -2,6 +2,11 @@
 // (nystrom/solve.hpp) on a Python force or a built-in problem (solve_binding.hpp); nystrom/_solve.py checks
 // the arguments and wraps the result. Library errors (std::invalid_argument, nystrom::invalid_input) reach
 // Python as ValueError with the library's one-line message.
+//
+// Lock discipline: the library's locks (the process-wide MPFR precision mutex of BigPrecision and
+// MpfrPrecision, the caches of method_data_for) are never waited for while the GIL is held. Every call that
+// may take one (method resolution, coefficient tables, BCH series, runs, MPFR dense output) runs with the GIL
+// released; the Python objects are built from its C++ result afterwards.
 #include <pybind11/complex.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -33,7 +38,18 @@ namespace py = pybind11;
 using namespace nystrom;
 using namespace nystrom::python;
 
+#ifndef NYSTROM_VERSION
+#error "NYSTROM_VERSION (the CMake project version) must be defined by the build"
+#endif
+
 namespace {
+
+/// f() with the GIL released (f touches no Python object).
+template <class F>
+auto released(F&& f) {
+  py::gil_scoped_release free;
+  return f();
+}
 
 py::dict info_dict(const MethodInfo& m) {
   py::dict d;
@@ -65,56 +81,64 @@ std::string show(const bigcomplex& x, int digits) {
 }
 
 py::dict mpe_coeffs(std::vector<long> k) {
-  validate_mpe_sequence(k);
-  const auto m = mpe_coefficients(k);
+  std::vector<std::string> coefficients;
+  std::string error;
+  int order = 0;
+  double amplification = 0;
+  released([&] {
+    validate_mpe_sequence(k);
+    const auto m = mpe_coefficients(k);
+    for (const auto& x : m.c) coefficients.push_back(x.get_str());
+    error = m.error.get_str();
+    order = m.order();
+    amplification = mpe_amplification(m);
+    return 0;
+  });
   long sum = 0;
   for (long x : k) sum += x;
-  py::list c;
-  for (const auto& x : m.c) c.append(x.get_str());
   py::dict d;
   d["family"] = "mpe";
   d["sequence"] = k;
-  d["order"] = m.order();
-  d["coefficients"] = c;
-  d["error_coefficient"] = m.error.get_str();
-  d["amplification"] = mpe_amplification(m);
+  d["order"] = order;
+  d["coefficients"] = coefficients;
+  d["error_coefficient"] = error;
+  d["amplification"] = amplification;
   d["force_evals_pv"] = sum;
   d["force_evals_vv"] = sum + 1;
   return d;
 }
 
-py::dict method_coeffs(const std::string& spec, int digits) {
+/// The coefficient table of a catalog method as JSON text (digits decimal digits), built without the GIL.
+std::string method_coeffs_json(const std::string& spec, int digits) {
   if (digits < 1 || digits > 1000) throw std::invalid_argument("digits must be between 1 and 1000");
+  py::gil_scoped_release free;
   const auto def = resolve_method(spec);
   BigPrecision guard(static_cast<unsigned>(digits * 3.33 + 64));
   const auto data = def.build();
-  py::dict j;
+  nlohmann::json j;
   j["method"] = def.info.name;
   j["order"] = def.info.order;
   j["source"] = def.info.source;
   auto vec = [&](const std::vector<bigcomplex>& v) {
-    py::list a;
-    for (const auto& x : v) a.append(show(x, digits));
+    auto a = nlohmann::json::array();
+    for (const auto& x : v) a.push_back(show(x, digits));
     return a;
   };
   if (const auto* sp = std::get_if<SplittingScheme<bigcomplex>>(&data)) {
     j["family"] = "splitting";
-    py::list steps;
-    for (const auto& s : sp->steps) {
-      py::dict st;
-      st["flow"] = s.flow == Flow::drift ? "drift" : "kick";
-      st["re"] = show(s.coef.re, digits);
-      st["im"] = show(s.coef.im, digits);
-      steps.append(st);
-    }
+    auto steps = nlohmann::json::array();
+    for (const auto& s : sp->steps)
+      steps.push_back({{"flow", s.flow == Flow::drift ? "drift" : "kick"},
+                       {"re", show(s.coef.re, digits)},
+                       {"im", show(s.coef.im, digits)}});
     j["steps"] = steps;
   } else if (const auto* t = std::get_if<RknTableau<bigcomplex>>(&data)) {
     j["family"] = "rkn";
     j["c"] = vec(t->c);
     j["b"] = vec(t->b);
     j["B"] = vec(t->B);
-    py::list a;
-    for (const auto& row : t->a) a.append(vec(row));
+    auto a = nlohmann::json::array();
+    for (const auto& row : t->a) a.push_back(vec(row));
     j["a"] = a;
   } else {
     const auto& m = std::get<MpeDef>(data);
@@ -122,12 +146,16 @@ py::dict method_coeffs(const std::string& spec, int digits) {
     j["family"] = "mpe";
     j["sequence"] = m.k;
     j["base"] = m.base_name;
-    py::list c;
-    for (const auto& x : mc.c) c.append(x.get_str());
+    auto c = nlohmann::json::array();
+    for (const auto& x : mc.c) c.push_back(x.get_str());
     j["coefficients"] = c;
     j["error_coefficient"] = mc.error.get_str();
   }
-  return j;
+  return j.dump();
+}
+
+py::object method_coeffs(const std::string& spec, int digits) {
+  return py::module_::import("json").attr("loads")(method_coeffs_json(spec, digits));
 }
 
 /// The BCH analysis of a splitting method as JSON text, the document `nystrom bch --json` prints.
@@ -144,6 +172,7 @@ std::string bch_json(const std::string& method, int degree, const std::string& b
   opt.algebra = an::parse_algebra(algebra);
   opt.precision_bits = bits;
   opt.tolerance = tolerance;
+  py::gil_scoped_release free;
   return an::bch_report_json<nlohmann::json>(an::analyze_method(resolve_method(method), opt)).dump();
 }
 
@@ -172,18 +201,27 @@ std::vector<double> flat(const DArray& a) { return std::vector<double>(a.data(),
 PYBIND11_MODULE(_core, m) {
   m.doc() = "Compiled core of nystrom: the method catalog and the integrators (use the nystrom package).";
   nystrom::analysis::register_method_file_reader();  // `file:PATH` method specifications
+  m.attr("__version__") = NYSTROM_VERSION;
+  m.attr("max_lie_degree") = nystrom::analysis::max_lie_degree;
 
   m.def(
       "methods",
       [] {
+        // The catalog is built at its first use, which takes the precision lock: without the GIL.
+        const auto infos = released([] {
+          std::vector<MethodInfo> v;
+          for (const auto& d : catalog()) v.push_back(d.info);
+          return v;
+        });
         py::list out;
-        for (const auto& d : catalog()) out.append(info_dict(d.info));
+        for (const auto& info : infos) out.append(info_dict(info));
         return out;
       },
       "Every method in the catalog, as a list of dicts.");
   m.def(
-      "method_info", [](const std::string& spec) { return info_dict(resolve_method(spec).info); }, py::arg("spec"),
-      "The catalog record of a method specification (a name, M<2n>, mpe:1,2,3, ...).");
+      "method_info",
+      [](const std::string& spec) { return info_dict(released([&] { return resolve_method(spec).info; })); },
+      py::arg("spec"), "The catalog record of a method specification (a name, M<2n>, mpe:1,2,3, ...).");
   m.def("mpe_coeffs", &mpe_coeffs, py::arg("sequence"), "Exact multi-product coefficients of a sequence.");
   m.def(
       "optimal_mpe_sequence", [](int n, long sum) { return optimal_mpe_sequence(n, sum); }, py::arg("n"),
@@ -214,8 +252,8 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "library_kepler_seconds",
       [](const std::string& method, double e, long steps_per_period, long periods) {
-        const MethodDef def = resolve_method(method);
         py::gil_scoped_release free;
+        const MethodDef def = resolve_method(method);
         const auto r = run_kepler<double>(def, e, steps_per_period, periods);
         return std::make_tuple(r.seconds, r.force_evals, r.position_error);
       },
@@ -233,7 +271,9 @@ PYBIND11_MODULE(_core, m) {
 
   m.def(
       "solve_method_info",
-      [](const std::string& spec, bool tolerance) { return info_dict(solve_method(spec, tolerance).info); },
+      [](const std::string& spec, bool tolerance) {
+        return info_dict(released([&] { return solve_method(spec, tolerance).info; }));
+      },
       py::arg("spec"), py::arg("tolerance"),
       "The catalog record of the method solve() runs for spec (with a tolerance: the adaptive form of a "
       "multi-product method).");
@@ -245,7 +285,13 @@ PYBIND11_MODULE(_core, m) {
         const auto k = static_cast<py::ssize_t>(ts.size());
         const auto n = static_cast<py::ssize_t>(s.dim());
         py::array_t<double> q({k, n}), v({k, n});
-        for (py::ssize_t i = 0; i < k; ++i) s.eval(ts.data()[i], q.mutable_data() + i * n, v.mutable_data() + i * n);
+        const double* t = ts.data();
+        double* qd = q.mutable_data();
+        double* vd = v.mutable_data();
+        {
+          py::gil_scoped_release free;  // an MPFR solution takes the precision lock around every evaluation
+          for (py::ssize_t i = 0; i < k; ++i) s.eval(t[i], qd + i * n, vd + i * n);
+        }
         return py::make_tuple(q, v);
       });
 
@@ -258,7 +304,7 @@ PYBIND11_MODULE(_core, m) {
          long max_steps, py::object progress, double checkpoint_at, std::string checkpoint_problem,
          std::string checkpoint_file, std::string restart_file) {
         SolveRequest r;
-        r.method = solve_method(method, rtol > 0 || atol > 0);
+        r.method = released([&] { return solve_method(method, rtol > 0 || atol > 0); });
         r.q0 = flat(q0);
         r.v0 = flat(v0);
         if (r.q0.size() != r.v0.size()) throw invalid_input("q0 and v0 differ in size");

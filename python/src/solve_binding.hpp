@@ -1,11 +1,13 @@
 // The Python module's binding of solve() (nystrom/solve.hpp; compiled in libnystrom for std::vector states): the one driver runs every integration
 // that nystrom.solve asks for. This header converts a request built from Python arguments into a
-// SecondOrderProblem, events and SolveOptions, runs solve() (with the GIL released when neither the
-// force nor an event calls into Python) and converts the Solution back: arrays of doubles, the final
-// state in full working precision as decimal strings, and sol(t) kept as a DenseSolution.
+// SecondOrderProblem, events and SolveOptions, runs solve() with the GIL released and converts the
+// Solution back: arrays of doubles, the final state in full working precision as decimal strings, and
+// sol(t) kept as a DenseSolution.
 //
-// Python callables (the force, events, progress) run with the GIL held; an exception they raise travels
-// through solve() as py::error_already_set and reaches the caller as the original Python exception.
+// Python callables (the force, events, progress) take the GIL for their call only; an exception they raise
+// travels through solve() as py::error_already_set and reaches the caller as the original Python exception.
+// The run itself holds no GIL, so that the library locks it takes (method_data_for, MPFR precision) are
+// never waited for with the GIL held.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -181,7 +183,9 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
 
   std::vector<Event<V>> events;
   for (const auto& e : r.events) {
-    auto g = [fn = e.g, n](const R& t, const V& q, const V& v) -> R {
+    // fn is borrowed from the request (alive for the run): copies of g touch no reference count.
+    auto g = [fn = py::handle(e.g), n](const R& t, const V& q, const V& v) -> R {
+      py::gil_scoped_acquire hold;
       py::array_t<double> qa(static_cast<py::ssize_t>(n)), va(static_cast<py::ssize_t>(n));
       for (std::size_t i = 0; i < n; ++i) {
         qa.mutable_at(i) = to_double(q[i]);
@@ -192,27 +196,19 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
     events.push_back({e.name, std::move(g), e.direction, e.terminal});
   }
 
-  // Python runs only in the heartbeat: the GIL is released for the whole run. Not in MPFR, whose run holds
-  // the process-wide precision lock: a thread waiting for that lock with the GIL would block this run's
-  // heartbeat.
-  const bool release = !python_force && events.empty() && mpfr_bits == 0;
+  // The GIL is released for the whole run; Python runs at every step with a Python force or events, or the
+  // steps are slow (MPFR).
+  const bool python_every_step = python_force || !events.empty() || mpfr_bits != 0;
   SolveOptions opt = r.options;
   opt.partial_on_failure = true;  // a failed run returns the states it reached, with status -1
   // Interruption checks (Ctrl-C) and progress every on_step_every steps: about 2^22 coordinate updates apart,
   // or every 64 steps when Python runs at every step anyway.
   const long work = static_cast<long>(m) * std::max(1, r.method.info.forces_per_step);
-  opt.on_step_every = release ? std::max(1L, (1L << 22) / std::max(1L, work)) : 64;
+  opt.on_step_every = python_every_step ? 64 : std::max(1L, (1L << 22) / std::max(1L, work));
   opt.on_step = [&](double t) {
-    auto beat = [&] {
-      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-      if (!r.progress.is_none()) r.progress(t);
-    };
-    if (release) {
-      py::gil_scoped_acquire hold;
-      beat();
-    } else {
-      beat();
-    }
+    py::gil_scoped_acquire hold;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (!r.progress.is_none()) r.progress(t);
   };
 
   opt.checkpoint_at = r.checkpoint_at;
@@ -242,10 +238,8 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   std::string message;
   const auto start = std::chrono::steady_clock::now();
   auto run = [&] { return from ? resume(prob, r.method, *from, opt, events) : solve(prob, r.method, opt, events); };
-  if (release) {
+  {
     py::gil_scoped_release free;
-    sol = run();
-  } else {
     sol = run();
   }
   if (sol.status == SolveStatus::terminated_by_event) {
@@ -261,18 +255,27 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   py::dict d;
   d["solve_seconds"] = seconds;
-  std::vector<double> t, q, v;
-  for (const auto& x : sol.t) t.push_back(as_double(x));
-  for (const auto& x : sol.q) append_doubles(x, n, q);
-  for (const auto& x : sol.v) append_doubles(x, n, v);
-  if (status == 1 && (t.empty() || t.back() != as_double(sol.t_final))) {  // the terminal event ends the output
-    t.push_back(as_double(sol.t_final));
-    append_doubles(sol.q_final, n, q);
-    append_doubles(sol.v_final, n, v);
-  }
-  d["t"] = py::array_t<double>(static_cast<py::ssize_t>(t.size()), t.data());
-  d["q"] = rows_array(q, t.size(), n);
-  d["v"] = rows_array(v, t.size(), n);
+  // The saved states, written once, straight into the arrays returned (every-step output: one per step).
+  const bool terminal_state =  // the terminal event ends the output
+      status == 1 && (sol.t.empty() || as_double(sol.t.back()) != as_double(sol.t_final));
+  const std::size_t rows = sol.t.size() + (terminal_state ? 1 : 0);
+  const auto nr = static_cast<py::ssize_t>(rows), nc = static_cast<py::ssize_t>(n);
+  py::array_t<double> ta(nr), qa({nr, nc}), va({nr, nc});
+  double* tp = ta.mutable_data();
+  double* qp = qa.mutable_data();
+  double* vp = va.mutable_data();
+  auto put = [&](std::size_t k, const auto& t, const V& q, const V& v) {
+    tp[k] = as_double(t);
+    for (std::size_t i = 0; i < n; ++i) {
+      qp[k * n + i] = to_double(q[i]);
+      vp[k * n + i] = to_double(v[i]);
+    }
+  };
+  for (std::size_t k = 0; k < sol.t.size(); ++k) put(k, sol.t[k], sol.q[k], sol.v[k]);
+  if (terminal_state) put(rows - 1, sol.t_final, sol.q_final, sol.v_final);
+  d["t"] = ta;
+  d["q"] = qa;
+  d["v"] = va;
   py::list hits;
   for (const auto& h : sol.events) {
     std::vector<double> hq, hv;

@@ -4,7 +4,9 @@
 // integrates it exactly (drifts move it by c h, RKN stages by c_i h, the multi-product combination has
 // coefficients summing to 1), and the force gets the time of each stage. A complex-coefficient method
 // passes complex arrays to the force.
+#include <algorithm>
 #include <complex>
+#include <string>
 #include <vector>
 
 #include "solve_binding.hpp"
@@ -13,10 +15,18 @@ namespace nystrom::python {
 
 namespace {
 
+std::string shape_text(const py::ssize_t* dims, std::size_t ndim) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < ndim; ++i) s += (i ? ", " : "") + std::to_string(dims[i]);
+  return s + (ndim == 1 ? ",)" : ")");
+}
+
 /// force(t, q) called once per force evaluation with q shaped like the user's q0 (the first n
-/// coordinates) and t from coordinate n.
+/// coordinates) and t from coordinate n. The run goes on without the GIL: each call takes it for the call
+/// only (fn is borrowed from the caller, who keeps it alive, so that copies of this functor touch no
+/// reference count).
 struct PyForce {
-  py::object fn;
+  py::handle fn;
   std::vector<py::ssize_t> shape;
   std::size_t n = 0;
 
@@ -25,6 +35,7 @@ struct PyForce {
            std::is_same_v<typename W::value_type, std::complex<double>>) void
   operator()(const W& q, W& a) const {
     using S = typename W::value_type;
+    py::gil_scoped_acquire hold;
     py::array_t<S> arr(shape);
     S* dst = arr.mutable_data();
     for (std::size_t i = 0; i < n; ++i) dst[i] = q[i];
@@ -35,9 +46,14 @@ struct PyForce {
                            std::string(py::str(py::type::of(r).attr("__name__"))));
     Arr res = Arr::ensure(r);
     if (!res) throw py::type_error("force(t, q) must return an array of numbers");
-    if (static_cast<std::size_t>(res.size()) != n)
-      throw py::value_error("force(t, q) returned " + std::to_string(res.size()) + " values for a state of " +
-                            std::to_string(n) + " coordinates");
+    // The exact shape of q: an array of the right size and another shape (q.T, a flattened q) is a
+    // mistake that would mix the coordinates up.
+    const bool same =
+        static_cast<std::size_t>(res.ndim()) == shape.size() && std::equal(shape.begin(), shape.end(), res.shape());
+    if (!same)
+      throw py::value_error("force(t, q) returned an array of shape " +
+                            shape_text(res.shape(), static_cast<std::size_t>(res.ndim())) + " for q of shape " +
+                            shape_text(shape.data(), shape.size()) + ": it must return q's shape");
     const S* src = res.data();
     for (std::size_t i = 0; i < n; ++i) a[i] = src[i];
     a[n] = S(0);
@@ -49,9 +65,9 @@ struct PyForce {
 
 py::dict solve_python_force(py::object force, std::vector<py::ssize_t> shape, const SolveRequest& r) {
   SolveRequest req = r;
-  req.options.engine.mpe_schedule = MpeSchedule::sequential;  // one thread: the force holds the GIL
+  req.options.engine.mpe_schedule = MpeSchedule::sequential;  // one thread calls the force
   const std::size_t n = r.q0.size();
-  return run_solve<std::vector<double>>(PyForce{std::move(force), std::move(shape), n}, req, true, true);
+  return run_solve<std::vector<double>>(PyForce{force, std::move(shape), n}, req, true, true);
 }
 
 }  // namespace nystrom::python

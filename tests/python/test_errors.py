@@ -63,7 +63,7 @@ def test_bad_arguments(kwargs, exc, match):
 
 
 def test_force_returning_the_wrong_shape_or_type():
-    with pytest.raises(ValueError, match="returned 3 values for a state of 2") as e:
+    with pytest.raises(ValueError, match=r"shape \(3,\) for q of shape \(2,\)") as e:
         nystrom.solve(lambda t, q: np.zeros(3), [1.0, 0.0], [0.0, 1.0], t_span=(0, 1), steps=10)
     one_line(e)
     with pytest.raises(TypeError, match="array of numbers"):
@@ -164,3 +164,75 @@ def test_coeffs_errors():
         nystrom.coeffs("NoSuchMethod")
     with pytest.raises(ValueError):
         nystrom.coeffs("VV", seq=[1, 2])
+
+
+@pytest.mark.parametrize("force,got", [
+    (lambda t, q: -q.T, "(3, 2)"),             # the transpose: the right size, coordinates mixed up
+    (lambda t, q: -q.reshape(-1), "(6,)"),     # flattened
+    (lambda t, q: -q[None], "(1, 2, 3)"),
+])
+def test_force_returning_another_shape_of_the_same_size_is_refused(force, got):
+    q0 = np.arange(1.0, 7.0).reshape(2, 3)
+    with pytest.raises(ValueError) as e:
+        nystrom.solve(force, q0, np.zeros((2, 3)), t_span=(0, 1), method="M4", steps=10)
+    assert one_line(e) == (f"force(t, q) returned an array of shape {got} for q of shape (2, 3): it must return "
+                           "q's shape")
+
+
+@pytest.mark.parametrize("method", ["M8", "FR", "DP12", "KL8", "mpe:1,2,3", "Chambers"])
+@pytest.mark.parametrize("built_in", [False, True])
+def test_fixed_step_method_without_h_or_steps_is_refused(method, built_in):
+    # never switched silently to an adaptive form: the C++ solve()'s error, with the method's name
+    args = (Kepler(0.5),) if built_in else (f, [1.0, 0.0], [0.0, 1.0])
+    with pytest.raises(ValueError) as e:
+        nystrom.solve(*args, t_span=(0, 1), method=method)
+    msg = one_line(e)
+    assert msg.endswith("runs with fixed steps: a fixed-step method needs a positive step size h or a number of "
+                        "steps")
+    assert msg.startswith("method '")
+
+
+def test_a_tolerance_still_selects_the_adaptive_form_of_a_multi_product_method():
+    res = nystrom.solve(Kepler(0.5), t_span=(0, 1), method="M8", rtol=1e-10)
+    assert res.method == "M8-adaptive" and res.h is None
+    res = nystrom.solve(Kepler(0.5), t_span=(0, 1), method="DP12-adaptive")  # adaptive: default rtol
+    assert res.success
+
+
+@pytest.mark.parametrize("kw", [dict(steps=10**9), dict(h=1e-9)])
+def test_every_step_output_that_cannot_fit_in_memory_is_refused_up_front(kw):
+    import time
+
+    start = time.monotonic()
+    with pytest.raises(ValueError, match="GB, more than this machine's") as e:
+        nystrom.solve(Kepler(0.5), t_span=(0, 1), method="M8", **kw)
+    one_line(e)
+    assert time.monotonic() - start < 5  # refused before the run, not after allocating
+    # with output times only, the same run needs no such memory: it is not refused up front
+    nystrom.solve(Kepler(0.5), t_span=(0, 1e-6), method="VV", steps=10, t_eval=[1e-6])
+
+
+def test_catalog_arguments_out_of_range_get_one_line_errors():
+    with pytest.raises(ValueError, match="MPE sequence member too large: 10+$") as e:
+        nystrom.coeffs("mpe", seq=[10**30])
+    one_line(e)
+    with pytest.raises(ValueError, match="positive") as e:
+        nystrom.coeffs("mpe", seq=[-(10**30)])
+    with pytest.raises(TypeError, match="sequence of integers") as e:
+        nystrom.coeffs("mpe", seq="123")  # a string is not read as [1, 2, 3]
+    one_line(e)
+    with pytest.raises(TypeError, match="sequence of integers"):
+        nystrom.coeffs("mpe", seq=[1.5, 2])
+    with pytest.raises(ValueError, match=r"degree must be between 1 and \d+, got 1099511627776") as e:
+        nystrom.bch("FR", degree=2**40)
+    one_line(e)
+    with pytest.raises(ValueError, match="bits must be between 64 and 4096") as e:
+        nystrom.bch("FR", bits=2**70)
+    with pytest.raises(ValueError, match="digits must be between 1 and 1000"):
+        nystrom.coeffs("FR", digits=10**20)
+    with pytest.raises(ValueError, match="n must be between"):
+        nystrom.coeffs("mpe", n=2**40, sum=10)
+    for call in (lambda: nystrom.coeffs("mpe", seq=[10**30]), lambda: nystrom.bch("FR", degree=2**40)):
+        with pytest.raises(Exception) as e:
+            call()
+        assert "Invoked with" not in str(e.value) and "incompatible" not in str(e.value)

@@ -442,3 +442,57 @@ def test_checkpoint_mismatches_and_bad_files_are_refused(tmp_path):
             nystrom.solve(prob, t_span=(0, 20.0), **kw)
     with pytest.raises(ValueError, match="another problem"):
         nystrom.solve(Kepler(0.3), t_span=(0, 20.0), method="M8", steps=2000, restart=path)
+
+
+@pytest.mark.parametrize("built_in", [False, True])
+def test_an_event_that_never_fires_gives_empty_arrays_of_the_state_shape(built_in):
+    prob = Kepler(E)
+
+    def never(t, q, v):
+        return 1.0
+
+    def y_zero(t, q, v):
+        return q[1]
+
+    args = (prob,) if built_in else (kepler_force, prob.q0, prob.v0)
+    res = nystrom.solve(*args, t_span=(0, 4.0), method="M8", h=0.02, events=[never, y_zero])
+    assert res.success
+    assert res.t_events[0].shape == (0,)
+    assert res.q_events[0].shape == (0, 2) and res.v_events[0].shape == (0, 2)
+    assert res.t_events[1] == pytest.approx([math.pi], abs=1e-9)  # the other event of the list still counts
+    assert res.q_events[1].shape == (1, 2)
+    res = nystrom.solve(*args, t_span=(0, 1.0), method="M8", h=0.02, events=never)
+    assert [a.shape for a in (res.t_events[0], res.q_events[0], res.v_events[0])] == [(0,), (0, 2), (0, 2)]
+
+
+def test_every_step_output_is_built_in_bulk(monkeypatch):
+    # no per-state conversion (a Python call per saved state would cost more than the C++ run itself)
+    calls = [0]
+    original = Kepler._from_flat
+
+    def counting(self, x):
+        calls[0] += 1
+        return original(self, x)
+
+    monkeypatch.setattr(Kepler, "_from_flat", counting)
+    res = nystrom.solve(Kepler(E), t_span=(0, 10.0), method="M8", steps=20000)
+    assert res.q.shape == (20001, 2) and res.v.shape == (20001, 2)
+    assert calls[0] <= 2
+    assert np.array_equal(res.q[0], Kepler(E).q0)
+
+
+def test_nbody_states_in_bulk_match_the_layout_of_one_state():
+    from nystrom.problems import NBody
+
+    sim = NBody(G=1.0)
+    sim.add(m=1.0)
+    sim.add(m=1e-3, x=1.0, vy=1.0)
+    sim.add(m=1e-4, x=-2.0, y=0.5, vy=-0.7, vz=0.1)
+    res = nystrom.solve(sim, t_span=(0, 1.0), method="M6", steps=50, events=lambda t, q, v: q[1, 1] - 0.5)
+    assert res.q.shape == (51, 3, 3)
+    assert np.array_equal(res.q[0], sim.q0) and np.array_equal(res.v[0], sim.v0)
+    flat = np.stack([sim._to_flat(x) for x in res.q])
+    assert np.array_equal(sim._rows_from_flat(flat), res.q)
+    assert np.array_equal(np.stack([sim._from_flat(x) for x in flat]), res.q)
+    assert res.q_events[0].shape[1:] == (3, 3)
+    assert res.q_events[0][0][1, 1] == pytest.approx(0.5, abs=1e-9)
