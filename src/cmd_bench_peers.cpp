@@ -17,8 +17,8 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include "experiments/peers.hpp"
 #include "cli.hpp"
+#include "experiments/peers.hpp"
 
 namespace {
 

@@ -10,9 +10,9 @@
 #include <string>
 
 #include "cli.hpp"
+#include "experiments/kepler.hpp"
 #include "nystrom/core/precision.hpp"
 #include "nystrom/engines/integrator.hpp"
-#include "experiments/kepler.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "runner.hpp"

@@ -54,8 +54,8 @@
 #include <utility>
 #include <vector>
 
-#include "nystrom/methods/refine.hpp"
 #include "experiments/kepler.hpp"
+#include "nystrom/methods/refine.hpp"
 #include "nystrom/nystrom.hpp"
 
 using namespace nystrom;

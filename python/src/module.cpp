@@ -22,11 +22,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/kepler.hpp"
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/analysis/bch_report.hpp"
 #include "nystrom/analysis/method_file.hpp"
 #include "nystrom/engines/mpe.hpp"
-#include "experiments/kepler.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/plummer.hpp"
 #include "solve_binding.hpp"

@@ -1,8 +1,8 @@
-// The Python module's binding of solve() (nystrom/solve.hpp; compiled in libnystrom for std::vector states): the one driver runs every integration
-// that nystrom.solve asks for. This header converts a request built from Python arguments into a
-// SecondOrderProblem, events and SolveOptions, runs solve() with the GIL released and converts the
-// Solution back: arrays of doubles, the final state in full working precision as decimal strings, and
-// sol(t) kept as a DenseSolution.
+// The Python module's binding of solve() (nystrom/solve.hpp; compiled in libnystrom for std::vector states): the one
+// driver runs every integration that nystrom.solve asks for. This header converts a request built from Python arguments
+// into a SecondOrderProblem, events and SolveOptions, runs solve() with the GIL released and converts the Solution
+// back: arrays of doubles, the final state in full working precision as decimal strings, and sol(t) kept as a
+// DenseSolution.
 //
 // Python callables (the force, events, progress) take the GIL for their call only; an exception they raise
 // travels through solve() as py::error_already_set and reaches the caller as the original Python exception.

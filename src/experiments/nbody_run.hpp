@@ -9,8 +9,8 @@
 #include <cmath>
 #include <string>
 
-#include "nystrom/engines/gbs.hpp"
 #include "localerr.hpp"
+#include "nystrom/engines/gbs.hpp"
 #include "nystrom/problems/kepler.hpp"
 
 namespace nystrom {
