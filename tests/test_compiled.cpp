@@ -152,6 +152,9 @@ TEST(Compiled, AForceThatResizesItsOutputIsRefused) {
 TEST(Compiled, ErrorsAreNystromErrors) {
   const auto prob = kepler_vec(0.0, 1.0);
   EXPECT_THROW((void)solve(prob, "M99x", {.steps = 10}), invalid_input);
+  // Both a step size and a number of steps: refused, as in Python (neither is silently ignored).
+  EXPECT_THROW((void)solve(prob, "M8", {.h = 0.5, .steps = 10}), invalid_input);
+  EXPECT_THROW((void)solve_inline(prob, "VV", {.h = 0.1, .steps = 10}), invalid_input);
   EXPECT_THROW((void)solve(prob, "DP12-adaptive", {.rtol = 1e-9, .max_steps = 0}), invalid_input);
   // A complex-coefficient method on a force that takes only real states.
   auto real_only = [](const Vd& q, Vd& a) { a[0] = -q[0]; };

@@ -401,6 +401,7 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
   const R aspan = dir > 0 ? span : R(-span);
   long n;
   R h;
+  if (opt.steps > 0 && opt.h != 0) throw invalid_input("give either h or steps, not both");
   if (opt.steps > 0) {
     n = opt.steps;
     h = aspan / R(n);
