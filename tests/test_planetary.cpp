@@ -230,6 +230,23 @@ TEST(KeplerDrift, RefusesACollisionOrbit) {
   EXPECT_THROW(kepler_drift(1.0, 1.0, x, v), std::invalid_argument);
 }
 
+TEST(KeplerDrift, NonFiniteInputIsRefusedWithItsReason) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto message = [](double mu, double dt, Vec3<double> x, Vec3<double> v) {
+    try {
+      kepler_drift(mu, dt, x, v);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message(1.0, nan, {1, 0, 0}, {0, 1, 0}).find("drift time is not finite"), std::string::npos);
+  EXPECT_NE(message(1.0, INFINITY, {1, 0, 0}, {0, 1, 0}).find("drift time is not finite"), std::string::npos);
+  EXPECT_NE(message(nan, 1.0, {1, 0, 0}, {0, 1, 0}).find("gravitational parameter"), std::string::npos);
+  EXPECT_NE(message(1.0, 1.0, {1, 0, 0}, {0, nan, 0}).find("velocity is not finite"), std::string::npos);
+  EXPECT_EQ(message(1.0, 1.0, {1, 0, 0}, {0, 1, 0}), "accepted");
+}
+
 // The short-drift path (cubic guess, Halley steps moving the G-functions by the addition theorems) on the outer
 // solar system's Jacobi orbits: taken for every drift at h = 25..400 days, and equal to the bracketed iteration
 // (the general path, which evaluates the G-functions afresh at every iterate) to a few units of rounding.
