@@ -12,7 +12,7 @@
 #include <string>
 
 #include "nystrom/problems/kepler.hpp"
-#include "nystrom/solve.hpp"
+#include "nystrom/solve_inline.hpp"  // std::array states: the inline path
 
 namespace {
 
