@@ -2,7 +2,8 @@
 // order it claims, the error on Kepler follows the tolerance, the step shrinks at pericentre and steps
 // are rejected there at e = 0.9, a high order at a tight tolerance does not aim below the
 // estimate's round-off, force evaluations are counted exactly, the lockstep and sequential
-// schedules give bitwise the same results, and bad input fails with std::invalid_argument.
+// schedules give bitwise the same results, and bad input fails with std::invalid_argument (nystrom::invalid_input
+// from the catalog).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -244,7 +245,7 @@ TEST(AdaptiveMpe, BadInputThrows) {
         << tol;
   for (const char* spec : {"mpe-adaptive:", "mpe-adaptive:1", "mpe-adaptive:1,1,2", "mpe-adaptive:0,1", "M2-adaptive",
                            "M7-adaptive", "mpe-vv-adaptive:x"})
-    EXPECT_THROW(resolve_method(spec), std::invalid_argument) << spec;
+    EXPECT_THROW(resolve_method(spec), invalid_input) << spec;
   EXPECT_THROW(adaptive_mpe_coefficients({}), std::invalid_argument);
   EXPECT_THROW(adaptive_mpe_coefficients({4}), std::invalid_argument);
   EXPECT_THROW(make_adaptive_mpe_integrator<V2>(resolve_method("DP12"), CountingKepler{&calls}, with_tol(1e-8)),
@@ -319,7 +320,7 @@ TEST(AdaptiveMpeOrderControl, CatalogEntry) {
   EXPECT_EQ(ai.order_histogram().size(), 11u);
   for (const char* spec : {"MPE-adaptive-max:", "MPE-adaptive-max:2", "MPE-adaptive-max:7", "MPE-adaptive-max:18",
                            "MPE-adaptive-max:100", "MPE-adaptive-max:x", "MPE-adaptive-max:-4", "MPE-adaptive-max:1e1"})
-    EXPECT_THROW(resolve_method(spec), std::invalid_argument) << spec;
+    EXPECT_THROW(resolve_method(spec), invalid_input) << spec;
 }
 
 // Work per unit step: a loose tolerance makes the low orders' steps nearly as long as the high orders', so

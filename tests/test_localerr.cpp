@@ -101,7 +101,7 @@ TEST(LocalErr, RefusesBadInput) {
   EXPECT_THROW(run_localerr(c), std::invalid_argument);
   c.hs = {0.01};
   c.methods = {"no-such-method"};
-  EXPECT_THROW(run_localerr(c), std::invalid_argument);
+  EXPECT_THROW(run_localerr(c), invalid_input);
   c.methods = {"VV"};
   c.setup.problem = "twobody";
   c.setup.ecc = 1.5;

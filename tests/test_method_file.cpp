@@ -147,7 +147,7 @@ TEST(MethodFile, RejectsBadFilesWithClearErrors) {
   EXPECT_NE(error_of("/nonexistent/method.txt").find("cannot read method file"), std::string::npos);
   // a device is refused before anything is read (/dev/zero would never end)
   EXPECT_NE(error_of("/dev/zero").find("it is a device"), std::string::npos);
-  EXPECT_THROW(resolve_method("file:/nonexistent/method.txt"), std::invalid_argument);
+  EXPECT_THROW(resolve_method("file:/nonexistent/method.txt"), invalid_input);
 }
 
 TEST(MethodFile, DeclaredOrderIsCheckedAgainstTheDigitsGiven) {
