@@ -255,7 +255,7 @@ TEST(QuantumSolve, BadInputIsRefused) {
   EXPECT_THROW(solve(p, "A6", 0.1, 10), std::invalid_argument);  // RKN tableau: classical only
   EXPECT_THROW(solve(p, "M8", -0.1, 10), std::invalid_argument);
   EXPECT_THROW(solve(p, "M8", std::nan(""), 10), std::invalid_argument);
-  EXPECT_THROW(solve(p, "nonsense", 0.1, 10), std::invalid_argument);
+  EXPECT_THROW(solve(p, "nonsense", 0.1, 10), nystrom::invalid_input);  // the catalog's refusal
   p.potential = "unknown";
   EXPECT_THROW(solve(p, "M8", 0.1, 10), std::invalid_argument);
   p = coherent_1d();
