@@ -26,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include "checksum.hpp"
 #include "cli_runner.hpp"
 
 extern char** environ;
@@ -565,18 +566,8 @@ TEST(CliHostile, InputFilesThatAreNotRegularFilesAreRefusedAtOnce) {
 
 namespace {
 
-// The FNV-1a 64 checksum line of a checkpoint's content (computed here, independently of the tool).
-std::string rechecksum(const std::string& text) {
-  const std::string body = text.substr(0, text.rfind("checksum "));
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : body) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  }
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "checksum fnv1a64 %016llx\n", static_cast<unsigned long long>(h));
-  return body + buf;
-}
+// The checkpoint with its checksum line recomputed (tests/checksum.hpp, independently of the tool).
+std::string rechecksum(const std::string& text) { return nystrom::test::with_checksum(nystrom::test::body_of(text)); }
 
 std::string replace_line(const std::string& text, const std::string& key, const std::string& line) {
   const auto a = text.find("\n" + key + " ");

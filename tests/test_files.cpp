@@ -26,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include "checksum.hpp"
 #include "kepler_solve.hpp"
 #include "nystrom/core/files.hpp"
 #include "nystrom/solve.hpp"
@@ -67,18 +68,8 @@ std::string error_of(F&& f) {
   return "(no error)";
 }
 
-// The FNV-1a 64 hash, written here independently of the library: a crafted checkpoint gets a valid checksum.
-std::string with_checksum(const std::string& body) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : body) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  }
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "checksum fnv1a64 %016llx\n", static_cast<unsigned long long>(h));
-  return body + buf;
-}
-std::string body_of(const std::string& text) { return text.substr(0, text.rfind("checksum ")); }
+using test::body_of;
+using test::with_checksum;
 
 // The line of `key` in a checkpoint text replaced by `line` (no line break), the checksum recomputed.
 std::string with_line(const std::string& text, const std::string& key, const std::string& line) {
