@@ -7,6 +7,7 @@
 #include <string>
 
 #include "nystrom/analysis/method_file.hpp"
+#include "nystrom/core/error.hpp"
 #include "nystrom/methods/catalog.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -19,7 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const nystrom::MethodDef d = nystrom::resolve_method(spec);
     if (d.info.name.empty() || d.info.order <= 0) __builtin_trap();  // a resolved method is complete
-  } catch (const std::invalid_argument&) {
+  } catch (const nystrom::invalid_input&) {                          // the one refusal of the catalog
   }
   return 0;
 }
