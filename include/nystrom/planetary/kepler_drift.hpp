@@ -134,7 +134,8 @@ void kepler_drift_bracketed(R mu, R dt, Vec3<R>& x, Vec3<R>& v) {
   using std::abs;
   using std::sqrt;
   if (dt == 0) return;
-  if (!std::isfinite(static_cast<double>(dt))) throw std::invalid_argument("Kepler drift: the drift time is not finite");
+  if (!std::isfinite(static_cast<double>(dt)))
+    throw std::invalid_argument("Kepler drift: the drift time is not finite");
   if (!(mu > 0) || !std::isfinite(static_cast<double>(mu)))
     throw std::invalid_argument("Kepler drift: the gravitational parameter must be positive and finite");
   for (int c = 0; c < 3; ++c)
