@@ -42,8 +42,7 @@ Solution<V> solve(const SecondOrderProblem<V, F>& problem, const std::string& me
   if constexpr (is_compiled_state<V>::value) {
     return compiled::solve<typename V::value_type>(erase(problem), nullptr, method, options, events, nullptr);
   } else {
-    // States that libnystrom does not compile: #include <nystrom/solve_inline.hpp>.
-    return solve_inline(problem, method, options, events);
+    return solve_inline(problem, method, options, events);  // std::array etc.: #include <nystrom/solve_inline.hpp>
   }
 }
 
@@ -54,7 +53,7 @@ Solution<V> solve(const SecondOrderProblem<V, F>& problem, const MethodDef& meth
   if constexpr (is_compiled_state<V>::value) {
     return compiled::solve<typename V::value_type>(erase(problem), &method, std::string(), options, events, nullptr);
   } else {
-    return solve_inline(problem, method, options, events);
+    return solve_inline(problem, method, options, events);  // std::array etc.: #include <nystrom/solve_inline.hpp>
   }
 }
 
@@ -68,7 +67,7 @@ Solution<V> resume(const SecondOrderProblem<V, F>& problem, const MethodDef& met
   if constexpr (is_compiled_state<V>::value) {
     return compiled::solve<typename V::value_type>(erase(problem), &method, std::string(), options, events, &from);
   } else {
-    return resume_inline(problem, method, from, options, events);
+    return resume_inline(problem, method, from, options, events);  // std::array: #include <nystrom/solve_inline.hpp>
   }
 }
 /// The same with the method given by its specification.
@@ -79,7 +78,7 @@ Solution<V> resume(const SecondOrderProblem<V, F>& problem, const std::string& m
   if constexpr (is_compiled_state<V>::value) {
     return compiled::solve<typename V::value_type>(erase(problem), nullptr, method, options, events, &from);
   } else {
-    return resume_inline(problem, method, from, options, events);
+    return resume_inline(problem, method, from, options, events);  // std::array: #include <nystrom/solve_inline.hpp>
   }
 }
 
