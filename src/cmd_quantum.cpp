@@ -19,6 +19,7 @@
 
 #include "cli.hpp"
 #include "nystrom/quantum/solve.hpp"
+#include "nystrom/solve/checkpoint.hpp"  // fnv1a64
 #ifdef NYSTROM_HAVE_MPI
 #include "nystrom/quantum/fftw_mpi.hpp"
 #endif
@@ -54,7 +55,8 @@ struct Options {
 
 /// MPI for one run when the tool was started by an MPI launcher (OpenMPI's mpirun sets OMPI_COMM_WORLD_SIZE,
 /// MPICH's PMI_SIZE, PMIx launchers PMIX_RANK); otherwise none, so a plain run neither needs nor starts MPI.
-/// Ranks other than 0 write nothing: every rank computes the same observables of the whole grid.
+/// Ranks other than 0 write nothing: every rank computes the same observables of the whole grid. Their
+/// standard error is kept aside for the one failure that only they can report (fail()).
 class MpiSession {
  public:
   MpiSession() {
@@ -65,6 +67,7 @@ class MpiSession {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (rank_ != 0) {
+      err_ = ::dup(STDERR_FILENO);
       const int null = ::open("/dev/null", O_WRONLY);
       if (null >= 0) {
         ::dup2(null, STDOUT_FILENO);
@@ -79,15 +82,62 @@ class MpiSession {
   ~MpiSession() {
 #ifdef NYSTROM_HAVE_MPI
     if (active_) MPI_Finalize();
+    if (err_ >= 0) ::close(err_);
 #endif
   }
   bool active() const { return active_; }
   int rank() const { return rank_; }
   int size() const { return size_; }
 
+  /// Before any rank starts the run: every rank must have read its input (`failure`: empty, or why not) and
+  /// hold the same arguments and input files (`fingerprint`, a hash of them). Otherwise every rank throws the
+  /// same UsageError (the first failing rank's reason, or the mismatch), so the run ends everywhere with one
+  /// line and exit status 2, before a rank waits for another or plans a transform of another grid.
+  void agree([[maybe_unused]] std::uint64_t fingerprint, const std::string& failure) const {
+#ifdef NYSTROM_HAVE_MPI
+    if (active_) {
+      int first = failure.empty() ? size_ : rank_;
+      MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+      if (first < size_) {
+        std::string why = failure;
+        int n = static_cast<int>(why.size());
+        MPI_Bcast(&n, 1, MPI_INT, first, MPI_COMM_WORLD);
+        why.resize(static_cast<std::size_t>(n));
+        MPI_Bcast(why.data(), n, MPI_CHAR, first, MPI_COMM_WORLD);
+        throw UsageError(first == 0 ? why : "MPI rank " + std::to_string(first) + ": " + why);
+      }
+      unsigned long long lo = fingerprint, hi = fingerprint;
+      MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_UNSIGNED_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
+      MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+      if (lo != hi)
+        throw UsageError(
+            "the MPI ranks were given different arguments or input files: every rank must run the same command on "
+            "the same files");
+      return;
+    }
+#endif
+    if (!failure.empty()) throw UsageError(failure);
+  }
+
+  /// A failure on this rank alone during the run (out of memory, a system error): the other ranks would wait
+  /// for it forever, so it is reported on this rank's standard error and every rank is stopped (exit 2).
+  void fail([[maybe_unused]] const std::string& why) const {
+#ifdef NYSTROM_HAVE_MPI
+    if (active_ && size_ > 1) {
+      const std::string line = "nystrom: error: MPI rank " + std::to_string(rank_) + ": " + why + "\n";
+      const int fd = rank_ == 0 ? STDERR_FILENO : err_;
+      if (fd >= 0 && ::write(fd, line.data(), line.size()) < 0) {
+        // nothing more to report with
+      }
+      MPI_Abort(MPI_COMM_WORLD, 2);
+    }
+#endif
+  }
+
  private:
   bool active_ = false;
   int rank_ = 0, size_ = 1;
+  int err_ = -1;  // rank != 0: its standard error
 };
 
 /// The text of a regular file of at most max_bytes bytes (nystrom::read_input_file: a directory, a FIFO or a
@@ -149,6 +199,32 @@ std::vector<std::complex<double>> read_initial_file(const std::string& path, std
     throw UsageError("--initial-file '" + path + "' has " + std::to_string(v.size()) + " values for " +
                      std::to_string(points) + " grid points");
   return v;
+}
+
+/// A hash of everything a run depends on: its options and the bytes of its input files; `failure` is set
+/// (instead of throwing) when an input file cannot be read, so that MPI ranks can agree first
+/// (MpiSession::agree).
+std::uint64_t fingerprint(const Options& o, std::string& failure) {
+  std::ostringstream s;
+  s << o.potential << '\0' << o.potential_file << '\0' << o.dims << '\0' << o.grid << '\0' << o.box << '\0' << o.method
+    << '\0' << o.dt << '\0' << o.steps << '\0' << o.imaginary << '\0' << o.allow_negative << '\0' << o.converge << '\0'
+    << o.initial_file << '\0' << o.x0 << '\0' << o.p0 << '\0' << o.width << '\0' << o.g << '\0' << o.precision << '\0'
+    << o.threads << '\0' << o.json << '\0' << o.autocorrelation << '\0' << o.states << '\0' << o.plot << '\0';
+  std::string text = s.str();
+  std::size_t points = 1;
+  for (int d = 0; d < o.dims; ++d) points *= static_cast<std::size_t>(o.grid);
+  const std::pair<const std::string*, const char*> files[] = {{&o.potential_file, "--potential-file"},
+                                                              {&o.initial_file, "--initial-file"}};
+  for (const auto& [path, flag] : files) {
+    if (path->empty()) continue;
+    try {
+      text += read_bounded(*path, flag, file_bound(points));
+      text += '\0';
+    } catch (const std::exception& e) {
+      failure = e.what();
+    }
+  }
+  return nystrom::checkpoint_detail::fnv1a64(text);
 }
 
 /// "1" (first axis) or "1,0,-0.5" (one value per axis).
@@ -309,7 +385,19 @@ nystrom::cli::Registrar reg(
           throw UsageError("--precision must be double or long-double, got '" + o->precision + "'");
         if (!o->plot.empty()) nystrom::cli::check_plot_target(o->plot);
         const MpiSession mpi;
-        const QuantumResult r = o->precision == "double" ? run<double>(*o, mpi) : run<long double>(*o, mpi);
+        std::string failure;
+        mpi.agree(fingerprint(*o, failure), failure);
+        QuantumResult r;
+        try {
+          r = o->precision == "double" ? run<double>(*o, mpi) : run<long double>(*o, mpi);
+        } catch (const nystrom::error&) {
+          throw;  // the same on every rank: the ranks hold the same input and share the observables
+        } catch (const std::invalid_argument&) {
+          throw;
+        } catch (const std::exception& e) {
+          mpi.fail(e.what());
+          throw;
+        }
         if (mpi.rank() != 0) return 0;
         if (!o->plot.empty()) plot_samples(o->plot, r, o->imaginary);
         if (o->json) {

@@ -438,4 +438,38 @@ TEST(QuantumMpi, TwoRanksGiveTheOneProcessResult) {
       "--json");
 }
 
+// Ranks that were given different arguments or input files, or that cannot read their input, all stop before
+// the run with one line and exit status 2 (a different grid on one rank would otherwise plan transforms of
+// another shape and corrupt memory, and a rank that failed alone would leave the others waiting forever).
+TEST(QuantumMpi, RanksThatDisagreeStopTogetherWithOneLine) {
+  const auto dir = cli_test::temp_dir();
+  const std::string common = "quantum --dims 2 --box 12 --method M4 --dt 0.1 --steps 5 --json";
+  std::string launcher = two_ranks();
+  launcher.replace(launcher.find("-np 2"), 5, "-np 1");
+  auto mpmd = [&](const std::string& a, const std::string& b) {
+    // `timeout` turns a hang into a failure of this test rather than of the whole suite.
+    return run(a + " : -np 1 " + cli_test::tool() + " " + b, dir, "timeout 60 " + launcher);
+  };
+  const auto grid = mpmd(common + " --grid 16", common + " --grid 20");
+  EXPECT_EQ(grid.code, 2) << grid.err;
+  EXPECT_NE(grid.err.find("nystrom: error: the MPI ranks were given different arguments"), std::string::npos)
+      << grid.err;
+  const auto precision = mpmd(common + " --grid 16", common + " --grid 16 --precision long-double");
+  EXPECT_EQ(precision.code, 2) << precision.err;
+  EXPECT_NE(precision.err.find("different arguments"), std::string::npos) << precision.err;
+  // The potential file of rank 1 is missing: rank 0 reports rank 1's reason.
+  {
+    std::ofstream f(dir / "v.txt");
+    for (int i = 0; i < 256; ++i) f << 0.5 * (i - 128) * (i - 128) / 256.0 << "\n";
+  }
+  const std::string one = "quantum --dims 2 --grid 16 --box 12 --method M4 --dt 0.1 --steps 5 --json --potential-file ";
+  const auto missing = mpmd(one + (dir / "v.txt").string(), one + (dir / "absent.txt").string());
+  EXPECT_EQ(missing.code, 2) << missing.err;
+  EXPECT_NE(missing.err.find("nystrom: error: MPI rank 1: "), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("absent.txt"), std::string::npos) << missing.err;
+  // The same command on every rank still runs.
+  const auto same = mpmd(one + (dir / "v.txt").string(), one + (dir / "v.txt").string());
+  EXPECT_EQ(same.code, 0) << same.err;
+}
+
 #endif

@@ -435,6 +435,59 @@ TEST(SolveEvents, KeplerApsidesAreTheAnalyticOnesToTheMethodsAccuracy) {
   }
 }
 
+TEST(SolveEvents, AnEventCostsTwoForcesAndAboutOneStepOfTheMethodInBothDirections) {
+  // The apsides of e = 0.9 over three orbits, forward from the apocentre and backward to near it: without
+  // dense output an event costs the forces at the ends of its step (2), one partial step of the method
+  // to the interpolant's estimate, and the force there (1); the times are the analytic ones to the
+  // method's accuracy, as with the dense output (which evaluates the force at every step end).
+  const KeplerProblem<double> kp(0.9);
+  const double T = 6 * pi - 0.5;
+  const auto ex = kp.exact(T);
+  struct Case {
+    std::string method;
+    SolveOptions opt;
+    long per_step;  // force evaluations of one step of the method (the partial step)
+  };
+  const std::vector<Case> cases = {
+      {"KL8", {.steps = 20000}, 17}, {"M8", {.steps = 20000}, 10}, {"DP12-adaptive", {.rtol = 1e-12}, 17}};
+  for (const int dir : {+1, -1}) {
+    const auto prob = dir > 0 ? kepler(0.9, 0.0, T) : SecondOrderProblem(KeplerForce{}, ex.q, ex.v, T, 0.5);
+    for (const auto& c : cases) {
+      SCOPED_TRACE(c.method + (dir > 0 ? " forward" : " backward"));
+      const auto sol = solve(prob, c.method, c.opt, apsides);
+      SolveOptions dense_opt = c.opt;
+      dense_opt.dense = true;
+      const auto dense = solve(prob, c.method, dense_opt, apsides);
+      ASSERT_EQ(sol.events.size(), 5u);
+      ASSERT_EQ(dense.events.size(), 5u);
+      const long per_event = 3 + c.per_step;
+      EXPECT_LE(sol.output_force_evals, 5 * per_event);
+      EXPECT_GE(sol.output_force_evals, 5 * 3);
+      EXPECT_LE(per_event, 20);
+      // Dense output: one force per step end and the start, plus a partial step and a force per event.
+      EXPECT_LE(dense.output_force_evals, sol.accepted + 1 + 5 * (1 + c.per_step));
+      for (std::size_t k = 0; k < 5; ++k) {
+        const auto& e = sol.events[k];
+        const int m = dir > 0 ? static_cast<int>(k) + 1 : 5 - static_cast<int>(k);  // t = m pi
+        EXPECT_EQ(e.name, m % 2 == 1 ? "pericentre" : "apocentre");
+        const double ts = m * pi;
+        EXPECT_NEAR(e.t, ts, apsis_time_bound(dense, kp, ts));
+        EXPECT_EQ(e.t, dense.events[k].t);  // the same location with or without the dense output
+        // The event's state: on the orbit at its time (positions and velocities).
+        const auto at = kp.exact(e.t);
+        EXPECT_NEAR(e.q[0], at.q[0], 1e-9);
+        EXPECT_NEAR(e.q[1], at.q[1], 1e-9);
+        EXPECT_NEAR(e.v[0], at.v[0], 1e-8);
+        EXPECT_NEAR(e.v[1], at.v[1], 1e-8);
+        // g = r.v vanishes there to the rounding of the time (|g'| <= |v|^2 + 1/r < 30).
+        EXPECT_LE(std::abs(e.q[0] * e.v[0] + e.q[1] * e.v[1]), 30 * 8e-16 * ts);
+      }
+      std::printf("%-14s %s: %ld output forces for 5 events (%ld steps)\n", c.method.c_str(),
+                  dir > 0 ? "forward " : "backward", sol.output_force_evals, sol.accepted);
+    }
+  }
+}
+
 TEST(SolveEvents, TerminalEventEndsTheRunThere) {
   const KeplerProblem<double> kp(0.9);
   const auto prob = kepler(0.9, 0.0, 20.0);
@@ -497,8 +550,13 @@ TEST(SolveEvents, HenonHeilesPoincareSectionLiesOnTheSectionAndTheEnergySurface)
       de_section = std::max(de_section, std::abs(energy(e.q, e.v) - E));
     }
     EXPECT_LE(de_section, 10 * de_ends);
-    std::printf("Henon-Heiles M8, %ld steps: %zu section points, energy error %.2e (step ends %.2e)\n", steps,
-                sol.events.size(), de_section, de_ends);
+    // Each section point: the forces at its step's two ends, one M8 step (10 forces) and one force at the
+    // interpolant's estimate; nothing else is evaluated for output.
+    EXPECT_LE(sol.output_force_evals, 13 * static_cast<long>(sol.events.size()));
+    std::printf(
+        "Henon-Heiles M8, %ld steps: %zu section points, energy error %.2e (step ends %.2e), %ld output "
+        "forces\n",
+        steps, sol.events.size(), de_section, de_ends, sol.output_force_evals);
   }
 }
 

@@ -8,6 +8,7 @@ import hashlib
 import math
 import numbers
 import os
+import tempfile
 
 import numpy as np
 
@@ -62,7 +63,17 @@ class DenseSolution:
 
     def _built(self):
         if self._core is None:
-            other = solve(**self._recipe).sol
+            recipe = dict(self._recipe)
+            restart_text = recipe.pop("restart_text", None)
+            if restart_text is None:
+                other = solve(**recipe).sol
+            else:  # a restarted run: from the checkpoint as it was read then, not from the file as it is now
+                with tempfile.TemporaryDirectory(prefix="nystrom-") as folder:
+                    path = os.path.join(folder, "restart.checkpoint")
+                    with open(path, "w", encoding="utf-8") as f:
+                        f.write(restart_text)
+                    recipe["restart"] = path
+                    other = solve(**recipe).sol
             self._core, self._rows = other._core, other._rows
         return self._core
 
@@ -280,8 +291,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         cannot fit in memory is refused before it starts).
     events : callable or list of callables
         ``event(t, q, v) -> float``; a zero crossed within a step is located on partial steps of the
-        method. Optional attributes ``terminal`` (stop at the first zero) and ``direction`` (>0 rising
-        only, <0 falling only).
+        method. Optional attributes ``terminal`` (stop at the first zero) and ``direction`` (>0: zeros
+        where g rises with t, <0: where it falls, in a backward run too; scipy's is along the integration).
     dense_output : bool
         Keep ``sol(t) -> (q, v)`` (:class:`DenseSolution`; one force evaluation per step end, counted in
         ``output_force_evals``).
@@ -442,6 +453,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.status = int(d["status"])
     res.message = d["message"]
     res.success = res.status >= 0
+    if restart is not None:
+        recipe["restart"], recipe["restart_text"] = None, d["restart_text"]
     res.sol = None if d["sol"] is None else DenseSolution(d["sol"], rows, shape, recipe)
     if evs:
         hits = [[x for x in d["events"] if x[0] == k] for k in range(len(evs))]

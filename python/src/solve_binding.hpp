@@ -298,6 +298,12 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   d["status"] = status;
   d["message"] = message;
   d["checkpoint_t"] = sol.checkpoint ? py::object(py::float_(as_double(sol.checkpoint->t))) : py::object(py::none());
+  // The checkpoint a restarted run continued from, as read: a pickled dense output repeats the run from these
+  // bytes, not from the file (which may have changed or gone since).
+  d["restart_text"] = py::none();
+  if constexpr (checkpoint_detail::exact_text<R>) {
+    if (from) d["restart_text"] = to_text(*from);
+  }
   if (opt.dense && status >= 0 && !sol.dense.empty())
     d["sol"] = py::cast(std::unique_ptr<DenseSolution>(new DenseSolutionOf<V>(std::move(sol), n, mpfr_bits)));
   else

@@ -209,6 +209,26 @@ def test_dense_output_pickles_and_evaluates_bitwise(python_force):
     assert np.allclose(q, prob.exact(DENSE_TIMES)[0], rtol=0, atol=1e-6)
 
 
+def test_pickled_dense_output_of_a_restarted_run_does_not_reread_the_checkpoint(tmp_path):
+    # The unpickled copy repeats the run from the checkpoint as it was read, even when the file has since
+    # been replaced by another run's checkpoint or removed.
+    prob = Kepler(0.6)
+    path = tmp_path / "run.checkpoint"
+    nystrom.solve(prob, t_span=(0, 20.5), method="M8", steps=3000, checkpoint=path, checkpoint_at=7.0)
+    res = nystrom.solve(prob, t_span=(0, 20.5), method="M8", steps=3000, restart=path, dense_output=True)
+    blob = pickle.dumps(res)
+    nystrom.solve(prob, t_span=(0, 20.5), method="M8", steps=3000, checkpoint=path, checkpoint_at=12.0)
+    times = DENSE_TIMES[DENSE_TIMES >= res.sol.t_min]
+    q, v = res.sol(times)
+    back = pickle.loads(blob)
+    q2, v2 = back.sol(times)
+    assert np.array_equal(q, q2) and np.array_equal(v, v2)
+    assert back.sol.t_min == res.sol.t_min
+    path.unlink()
+    q3, v3 = pickle.loads(blob).sol(times)
+    assert np.array_equal(q, q3) and np.array_equal(v, v3)
+
+
 def test_dense_output_of_an_unpicklable_force_refuses_to_pickle():
     prob = Kepler(0.6)
     res = nystrom.solve(lambda t, q: -q / np.dot(q, q) ** 1.5, prob.q0, prob.v0, t_span=(0, 1.0), steps=10,

@@ -371,6 +371,36 @@ def test_backward_event_and_dense_output():
     assert np.allclose(q, prob.exact(-1.5)[0], atol=1e-9)
 
 
+def test_event_direction_is_in_t_in_both_time_directions_and_an_event_costs_about_one_step():
+    # y = q[1] falls through zero at the pericentres t = pi, 3 pi (forward, from the apocentre) and, run
+    # backward, at t = -pi, -3 pi: direction=-1 selects the zeros where y falls with t, whichever the
+    # direction of integration; direction=+1 the others (t = +-2 pi, at the apocentre).
+    prob = Kepler(E)
+
+    def y_falls(t, q, v):
+        return q[1]
+
+    def y_rises(t, q, v):
+        return q[1]
+
+    y_falls.direction = -1
+    y_rises.direction = +1
+    for sign in (1, -1):
+        res = nystrom.solve(prob, t_span=(0, sign * (3 * math.pi + 0.5)), method="M8", h=0.01,
+                            events=[y_falls, y_rises])
+        falls = [sign * math.pi, sign * 3 * math.pi]
+        rises = [sign * 2 * math.pi]
+        assert np.allclose(res.t_events[0], falls, atol=1e-9), res.t_events
+        assert np.allclose(res.t_events[1], rises, atol=1e-9), res.t_events
+        # Velocities at the events: (0, -v_peri) at the pericentre, (0, +v_apo) at the apocentre, run in
+        # either direction (velocities are those of the orbit, not of the direction of integration).
+        vp = math.sqrt((1 + E) / (1 - E))
+        assert np.allclose(res.v_events[0], [[0.0, -vp]] * 2, atol=1e-8)
+        # Three events: the forces at the two ends of each event's step, one M8 step (10 forces) and
+        # the force at the estimate; without dense output nothing else is evaluated for output.
+        assert 3 * 3 <= res.output_force_evals <= 3 * 13, res.output_force_evals
+
+
 def test_gbs_reaches_its_tolerance():
     prob = Kepler(E)
     res = nystrom.solve(kepler_force, prob.q0, prob.v0, t_span=(0, T_END), method="GBS", rtol=1e-11,
