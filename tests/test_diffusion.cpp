@@ -270,6 +270,7 @@ TEST(Smoluchowski, BadInputIsRefused) {
   refused([](auto& p) { p.potential = "morse"; }, "unknown potential");
   refused([](auto& p) { p.width = 3; }, "does not resolve");  // broader than e^{-beta U/2}: rho0 e^{beta U/2} grows
   refused([](auto& p) { p.grid = 8; }, "at least 16");
+  refused([](auto& p) { p.box = 6; }, "larger box");  // e^{-x^2/2} is 0.011 at the edge
   refused([](auto& p) { p.initial.assign(128, -1.0); }, "initial");
   refused([](auto& p) { p.x0 = {1, 2}; }, "x0");
 }

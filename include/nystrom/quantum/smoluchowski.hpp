@@ -349,6 +349,23 @@ SmoluchowskiResult smoluchowski(const SmoluchowskiProblem<R>& p, const std::stri
       throw std::invalid_argument(
           "the initial density times e^{beta U/2} overflows towards the edges of the box: "
           "use a narrower initial density, a smaller box or a smaller beta");
+  {
+    // e^{-beta U/2} must be resolved; where it does not vanish at the edges of the box (a confining potential in a box
+    // too small), its periodic continuation has a kink
+    Field<R> b(n);
+    R edge = 0;
+    for_each_point(grid, PointRange{}, [&](std::size_t i, const int* idx) {
+      b[i] = half[i];
+      for (int a = 0; a < grid.dims; ++a)
+        if (idx[a] == 0) edge = std::max(edge, half[i]);
+    });
+    if (detail::spectral_tail(flows, b) > 1e-10)
+      throw std::invalid_argument(
+          edge > R(1e-6) ? "e^{-beta U/2}, the square root of the Boltzmann density, does not vanish at the edges of "
+                           "the box and is not smooth across them: use a larger box (or a larger beta)"
+                         : "the grid does not resolve e^{-beta U/2}, the square root of the Boltzmann density: use a "
+                           "finer grid (or a smaller box, or a smaller beta)");
+  }
   const double tail = detail::spectral_tail(flows, psi);
   if (tail > 1e-10) {
     char buf[64];
@@ -357,14 +374,6 @@ SmoluchowskiResult smoluchowski(const SmoluchowskiProblem<R>& p, const std::stri
                                 " of its norm in the highest wave numbers): the initial density must be smooth on the "
                                 "grid and fall faster than e^{-beta U/2} towards the edges of the box; use a finer "
                                 "grid, a smaller box or a narrower initial density");
-  }
-  {
-    Field<R> b(n);
-    for (std::size_t i = 0; i < n; ++i) b[i] = half[i];
-    if (detail::spectral_tail(flows, b) > 1e-10)
-      throw std::invalid_argument(
-          "the grid does not resolve e^{-beta U/2}, the square root of the Boltzmann "
-          "density: use a finer grid (or a smaller box, or a smaller beta)");
   }
 
   const R dtau = 2 * p.diffusion * dt;
