@@ -233,25 +233,50 @@ TEST(Smoluchowski, RatesOfTheOrnsteinUhlenbeckProcessIn2D) {
   EXPECT_LT(r.exact_error, 1e-8);
 }
 
+// The 3D Ornstein-Uhlenbeck density: a Gaussian per axis, mean x0_j e^{-D beta t}, with 4A (gradient term in 3D).
+TEST(Smoluchowski, OrnsteinUhlenbeckDensityIn3D) {
+  SmoluchowskiProblem<double> p;
+  p.dims = 3;
+  p.grid = 40;
+  p.box = 16;
+  p.potential = "harmonic";
+  p.beta = 2;
+  p.diffusion = 0.5;
+  p.x0 = {0.5, -0.25, 0.0};
+  p.width = 0.7;
+  const auto r = smoluchowski(p, "4A", 0.05, 20);
+  EXPECT_EQ(r.exact_solution, "Ornstein-Uhlenbeck");
+  EXPECT_LT(r.exact_error, 1e-6);
+  EXPECT_NEAR(r.mean[0], 0.5 * std::exp(-1.0), 1e-7);
+  EXPECT_NEAR(r.mean[1], -0.25 * std::exp(-1.0), 1e-7);
+  EXPECT_NEAR(r.mean[2], 0.0, 1e-12);
+  EXPECT_LT(std::abs(r.mass_drift), 1e-7);
+}
+
 // A user's potential given by its values (derivatives by differences on the grid) gives the built-in result.
 TEST(Smoluchowski, PotentialValuesGiveTheBuiltInResult) {
-  SmoluchowskiProblem<double> p;
-  p.grid = 96;
-  p.box = 5;
-  p.beta = 3;
-  p.rates = 1;
-  p.x0 = {-1.0};
-  p.width = 0.12;
-  const auto builtin = smoluchowski(p, "M6", 0.02, 100);
-  const Grid<double> g(1, p.grid, p.box);
-  for (int i = 0; i < p.grid; ++i) {
-    const double x = g.coordinate(i);
-    p.values.push_back((x * x - 1) * (x * x - 1));
+  // differences of order 8 are exact for U (degree 4) and W (degree 6) away from the four points next to the edge,
+  // where e^{-beta U} vanishes; 4A uses |grad W|^2 from them too
+  for (const std::string method : {"M6", "4A"}) {
+    SmoluchowskiProblem<double> p;
+    p.grid = 96;
+    p.box = 5;
+    p.beta = 3;
+    p.rates = 1;
+    p.x0 = {-1.0};
+    p.width = 0.12;
+    const auto builtin = smoluchowski(p, method, 0.02, 100);
+    const Grid<double> g(1, p.grid, p.box);
+    for (int i = 0; i < p.grid; ++i) {
+      const double x = g.coordinate(i);
+      p.values.push_back((x * x - 1) * (x * x - 1));
+    }
+    const auto user = smoluchowski(p, method, 0.02, 100);
+    EXPECT_NEAR(user.rates[0], builtin.rates[0], 1e-9 * builtin.rates[0]) << method;
+    EXPECT_NEAR(user.mean[0], builtin.mean[0], 1e-9) << method;
+    EXPECT_NEAR(user.variance[0], builtin.variance[0], 1e-9) << method;
+    EXPECT_TRUE(std::isnan(user.kramers_rate));
   }
-  const auto user = smoluchowski(p, "M6", 0.02, 100);
-  EXPECT_NEAR(user.rates[0], builtin.rates[0], 1e-9 * builtin.rates[0]);
-  EXPECT_NEAR(user.mean[0], builtin.mean[0], 1e-9);
-  EXPECT_TRUE(std::isnan(user.kramers_rate));
 }
 
 TEST(Smoluchowski, BadInputIsRefused) {
