@@ -16,12 +16,14 @@ import numbers
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
 from ._quantum import QuantumResult, quantum
+from ._diffusion import SmoluchowskiResult, ThermalResult, smoluchowski, thermal
 from .ensemble import ensemble
 from . import problems
 
 __version__ = _core.__version__  # the CMake project version, as `nystrom --version` prints it
 
 __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
+           "smoluchowski", "SmoluchowskiResult", "thermal", "ThermalResult",
            "problems", "ensemble", "plot"]
 
 

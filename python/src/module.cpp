@@ -31,6 +31,7 @@
 #include "nystrom/problems/plummer.hpp"
 #include "solve_binding.hpp"
 #ifdef NYSTROM_PYTHON_QUANTUM
+#include "diffusion_binding.hpp"
 #include "quantum_binding.hpp"
 #endif
 
@@ -345,5 +346,6 @@ PYBIND11_MODULE(_core, m) {
 
 #ifdef NYSTROM_PYTHON_QUANTUM
   register_quantum(m);
+  register_diffusion(m);
 #endif
 }
