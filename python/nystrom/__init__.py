@@ -5,7 +5,8 @@
                         t_span=(0, 20 * np.pi), method="M8", steps=20000)
     res.q[-1], res.force_evals
 
-Built-in problems (``nystrom.problems``) and the split-operator Schrödinger solver (``nystrom.quantum``) run
+Built-in problems (``nystrom.problems``), the exact velocity-dependent flows (``nystrom.flows``: a rotating
+frame, a magnetic field, friction) and the split-operator Schrödinger solver (``nystrom.quantum``) run
 in C++ with the GIL released; ``nystrom.ensemble`` maps runs over a process pool, a Dask client or an MPI
 pool; ``nystrom.plot`` draws orbits, energy errors and work-precision charts.
 """
@@ -15,6 +16,7 @@ import numbers
 
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
+from ._flows import FlowResult, flows
 from ._quantum import QuantumResult, quantum
 from .ensemble import ensemble
 from . import problems
@@ -22,6 +24,7 @@ from . import problems
 __version__ = _core.__version__  # the CMake project version, as `nystrom --version` prints it
 
 __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
+           "flows", "FlowResult",
            "problems", "ensemble", "plot"]
 
 

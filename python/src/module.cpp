@@ -31,6 +31,7 @@
 #include "nystrom/problems/plummer.hpp"
 #include "solve_binding.hpp"
 #ifdef NYSTROM_PYTHON_QUANTUM
+#include "flows_binding.hpp"
 #include "quantum_binding.hpp"
 #endif
 
@@ -343,6 +344,7 @@ PYBIND11_MODULE(_core, m) {
       "solve() (nystrom/solve.hpp) on a built-in problem (problem: its name) or a Python force(t, q) "
       "(problem: ''); nystrom.solve checks the arguments and wraps the result.");
 
+  register_flows(m);
 #ifdef NYSTROM_PYTHON_QUANTUM
   register_quantum(m);
 #endif
