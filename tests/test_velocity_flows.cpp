@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "nystrom/methods/catalog.hpp"
 #include "nystrom/velocity/solve.hpp"
 
 using namespace nystrom;
@@ -248,6 +249,63 @@ TEST(Damped, SplittingIsConformallySymplectic) {
   };
   for (const std::string m : {"VV", "FR", "KL8"}) EXPECT_NEAR(det(m), std::exp(-gamma * h), 1e-15) << m;
   EXPECT_GT(std::abs(det("M4") - std::exp(-gamma * h)), 1e-7);
+}
+
+// ---- the whole catalog ------------------------------------------------------------------------------------
+
+/// Every method of the catalog either runs on these flows with its declared order (the Penning trap, long double,
+/// both time directions, positions and velocities against the exact solution; the damped driven oscillator too up
+/// to order 10, beyond which its errors reach the long double floor before the asymptotic regime) or is refused:
+/// the RKN tableaux, the adaptive methods and those with complex coefficients.
+TEST(VelocityFlows, EveryApplicableCatalogMethodShowsItsOrder) {
+  using R = long double;
+  const auto trap = penning<R>(1, R(0.02), {1, 0, R(0.5)}, {0, 1, R(0.1)});
+  const auto osc = damped_oscillator<R>(R(0.3), 1, R(0.5), R(0.7), 1, 0);
+  int ran = 0;
+  for (const auto& def : catalog()) {
+    const std::string m = def.info.name;
+    const bool refuse = def.info.family == "rkn" || def.info.adaptive || def.info.complex;
+    if (refuse) {
+      EXPECT_THROW(resolve_velocity_method(m, 64, "long-double"), invalid_input) << m;
+      continue;
+    }
+    ++ran;
+    for (R dir : {R(1), R(-1)}) {
+      // the first n (doubling from 4) whose error is below `below`, and 2 n (the optimised methods, e.g.
+      // RKNb6, reach their asymptotic slope late: their leading error term is small; orders above 10 reach the
+      // rounding floor within a few doublings)
+      auto measure = [&](double below, auto error) {
+        long n = 4;
+        double ea = error(n);
+        while (ea > below && n < 100000) ea = error(n *= 2);
+        return std::pair{ea, error(2 * n)};
+      };
+      // the trap's error: the largest over four evenly spaced times (at one time alone the oscillating modes'
+      // errors can partly cancel for some n, which hides the asymptotic slope)
+      const auto [ta, tb] = measure(def.info.order > 10 ? 1e-6 : 1e-9, [&](long n) {
+        const FlowResult r = solve(trap, m, dir * R(30) / static_cast<R>(n), n, 4);
+        double e = 0;
+        for (std::size_t i = 1; i < r.samples.size(); ++i) {
+          Vec3<R> q = trap.q0, v = trap.v0;
+          trap.exact(dir * R(30) * static_cast<R>(i) / 4, q, v);
+          for (std::size_t c = 0; c < 3; ++c)
+            e = std::max({e, std::abs(r.samples[i].q[c] - static_cast<double>(q[c])),
+                          std::abs(r.samples[i].v[c] - static_cast<double>(v[c]))});
+        }
+        return e;
+      });
+      EXPECT_GT(slope(ta, tb), def.info.order - 0.4) << m << " penning " << ta << " " << tb;
+      EXPECT_LT(slope(ta, tb), def.info.order + 1.2) << m << " penning " << ta << " " << tb;
+      if (def.info.order > 10) continue;
+      const auto [da, db] = measure(1e-7, [&](long n) {
+        const FlowResult r = solve(osc, m, dir * R(10) / static_cast<R>(n), n);
+        return std::max(r.position_error, r.velocity_error);
+      });
+      EXPECT_GT(slope(da, db), def.info.order - 0.4) << m << " damped " << da << " " << db;
+      EXPECT_LT(slope(da, db), def.info.order + 1.0) << m << " damped " << da << " " << db;
+    }
+  }
+  EXPECT_GE(ran, 28);
 }
 
 // ---- methods and input ---------------------------------------------------------------------------------
