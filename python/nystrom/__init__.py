@@ -16,7 +16,7 @@ import numbers
 
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
-from ._flows import FlowResult, flows
+from ._flows import FlowResult, damped, flows, magnetic, rotating_frame
 from ._quantum import QuantumResult, quantum
 from .ensemble import ensemble
 from . import problems
@@ -24,7 +24,7 @@ from . import problems
 __version__ = _core.__version__  # the CMake project version, as `nystrom --version` prints it
 
 __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
-           "flows", "FlowResult",
+           "flows", "rotating_frame", "magnetic", "damped", "FlowResult",
            "problems", "ensemble", "plot"]
 
 

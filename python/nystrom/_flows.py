@@ -10,6 +10,15 @@ input are the library's (ValueError with its one-line message).
 >>> res = nystrom.flows("arenstorf", method="KL8", periods=1)
 >>> res.return_error < 1e-8, res.force_evals
 (True, 340000)
+
+Problems of your own, with forces written in Python (each kick calls them once, with the GIL held):
+``rotating_frame(gradient, q0, v0, dt, steps, omega=...)``, ``magnetic(q0, v0, dt, steps, b=..., force=...)`` and
+``damped(force, q0, v0, dt, steps, gamma=...)``.
+
+>>> import numpy as np
+>>> r = nystrom.damped(lambda t, q: -q, [1.0], [0.0], dt=0.01, steps=100, gamma=0.0, method="FR")
+>>> bool(abs(r.q[0] - np.cos(1.0)) < 1e-9)
+True
 """
 
 import numbers
@@ -17,7 +26,7 @@ import numbers
 from . import _core
 from ._result import AttrDict
 
-__all__ = ["flows", "FlowResult"]
+__all__ = ["flows", "rotating_frame", "magnetic", "damped", "FlowResult"]
 
 
 class FlowResult(AttrDict):
@@ -97,4 +106,61 @@ def flows(problem="arenstorf", method=None, periods=None, steps_per_period=None,
                     omega0=_opt_real("omega0", omega0), drive=_opt_real("drive", drive),
                     drive_frequency=_opt_real("drive_frequency", drive_frequency), q0=_opt_vector("q0", q0),
                     v0=_opt_vector("v0", v0), precision=precision)
+    return FlowResult(d)
+
+
+def _steps(dt, steps, samples):
+    return _opt_real("dt", dt), _opt_int("steps", steps), 0 if samples is None else _opt_int("samples", samples)
+
+
+def _callable(name, f, required):
+    if f is None:
+        if required:
+            raise TypeError(f"{name} is required")
+        return None
+    if not callable(f):
+        raise TypeError(f"{name} must be callable")
+    return f
+
+
+def rotating_frame(gradient, q0, v0, dt, steps, *, omega=(0.0, 0.0, 1.0), potential=None, method=None, samples=0):
+    """q'' = -2 Omega x v - Omega x (Omega x q) - grad U(q) in a frame rotating with ``omega`` (3 components).
+
+    gradient(q) returns grad U (3 numbers); potential(q), optional, returns U for the Jacobi integral
+    (``invariant``). q0, v0: 3 components (v0 is the velocity in the rotating frame). ``dt`` may be negative
+    (backward in time). Any real splitting or multi-product method of the catalog (default KL8).
+    """
+    dt, steps, samples = _steps(dt, steps, samples)
+    d = _core.flows_custom(family="rotating", axis=_opt_vector("omega", omega), gamma=0.0,
+                           q0=_opt_vector("q0", q0), v0=_opt_vector("v0", v0), t0=0.0,
+                           force=_callable("gradient", gradient, True),
+                           potential=_callable("potential", potential, False), method=method or "", dt=dt,
+                           steps=steps, samples=samples)
+    return FlowResult(d)
+
+
+def magnetic(q0, v0, dt, steps, *, b=(0.0, 0.0, 1.0), force=None, potential=None, method=None, samples=0):
+    """q'' = v x b + a(q): a charged particle in the uniform field b = (charge/mass) B (3 components).
+
+    force(q), optional, returns a(q) = (charge/mass) E(q) (3 numbers); potential(q), optional, returns phi with
+    a = -grad phi for the energy (``invariant``). ``dt`` may be negative. Default method KL8.
+    """
+    dt, steps, samples = _steps(dt, steps, samples)
+    d = _core.flows_custom(family="magnetic", axis=_opt_vector("b", b), gamma=0.0, q0=_opt_vector("q0", q0),
+                           v0=_opt_vector("v0", v0), t0=0.0, force=_callable("force", force, False),
+                           potential=_callable("potential", potential, False), method=method or "", dt=dt,
+                           steps=steps, samples=samples)
+    return FlowResult(d)
+
+
+def damped(force, q0, v0, dt, steps, *, gamma, t0=0.0, method=None, samples=0):
+    """q'' = -gamma v + a(t, q) in d = len(q0) dimensions from the time t0.
+
+    force(t, q) returns a(t, q) (d numbers; None: no force). ``dt`` may be negative. Default method KL8.
+    """
+    dt, steps, samples = _steps(dt, steps, samples)
+    d = _core.flows_custom(family="damped", axis=[], gamma=_opt_real("gamma", gamma), q0=_opt_vector("q0", q0),
+                           v0=_opt_vector("v0", v0), t0=_opt_real("t0", t0),
+                           force=_callable("force", force, False), potential=None, method=method or "", dt=dt,
+                           steps=steps, samples=samples)
     return FlowResult(d)

@@ -78,3 +78,43 @@ def test_docstring_examples_run():
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
     assert result.attempted >= 2
     assert result.failed == 0
+
+
+def test_a_rotating_frame_from_python_is_the_built_in_arenstorf():
+    mu = 0.012277471
+    built = nystrom.flows("arenstorf", method="M8", periods=0.1, steps_per_period=20000)
+
+    def gradient(q):
+        r1 = np.array([q[0] + mu, q[1], q[2]])
+        r2 = np.array([q[0] - (1 - mu), q[1], q[2]])
+        return (1 - mu) * r1 / np.linalg.norm(r1) ** 3 + mu * r2 / np.linalg.norm(r2) ** 3
+
+    def potential(q):
+        return -(1 - mu) / math.hypot(q[0] + mu, q[1], q[2]) - mu / math.hypot(q[0] - 1 + mu, q[1], q[2])
+
+    own = nystrom.rotating_frame(gradient, [0.994, 0, 0], [0, -2.00158510637908252240537862224, 0], dt=built.dt,
+                                 steps=built.steps, omega=[0, 0, 1], potential=potential, method="M8")
+    assert own.force_evals == built.force_evals
+    assert np.max(np.abs(own.q - built.q)) < 1e-10 and np.max(np.abs(own.v - built.v)) < 1e-9
+    assert abs(own.invariant0 - built.invariant0) < 1e-14 and own.invariant_error < 1e-9
+
+
+def test_a_magnetic_field_from_python_gives_the_exact_helix_backward():
+    built = nystrom.flows("helix", method="KL8", periods=-2.5, steps_per_period=32)
+    e = np.array([0.1, 0.0, 0.05])
+    own = nystrom.magnetic([1, 0, 0], [0, 1, 0.1], dt=built.dt, steps=built.steps, b=[0, 0, 1],
+                           force=lambda q: e, potential=lambda q: -float(e @ q), method="KL8")
+    assert own.time < 0
+    assert np.max(np.abs(own.q - built.q)) < 1e-12 and np.max(np.abs(own.v - built.v)) < 1e-12
+    assert built.position_error < 1e-12
+
+
+def test_python_forces_are_checked_and_their_errors_propagate():
+    with pytest.raises(ValueError, match="must return 1 numbers"):
+        nystrom.damped(lambda t, q: [1.0, 2.0], [1.0], [0.0], dt=0.1, steps=3, gamma=0.1)
+    with pytest.raises(ZeroDivisionError):
+        nystrom.damped(lambda t, q: 1 / 0, [1.0], [0.0], dt=0.1, steps=3, gamma=0.1)
+    with pytest.raises(TypeError):
+        nystrom.rotating_frame(None, [1, 0, 0], [0, 1, 0], dt=0.1, steps=3)
+    with pytest.raises(ValueError, match="3 components"):
+        nystrom.magnetic([1, 0], [0, 1, 0], dt=0.1, steps=3)
