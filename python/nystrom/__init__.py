@@ -5,7 +5,8 @@
                         t_span=(0, 20 * np.pi), method="M8", steps=20000)
     res.q[-1], res.force_evals
 
-Built-in problems (``nystrom.problems``) and the split-operator Schrödinger solver (``nystrom.quantum``) run
+Built-in problems (``nystrom.problems``), the exact velocity-dependent flows (``nystrom.flows``: a rotating
+frame, a magnetic field, friction) and the split-operator Schrödinger solver (``nystrom.quantum``) run
 in C++ with the GIL released; ``nystrom.ensemble`` maps runs over a process pool, a Dask client or an MPI
 pool; ``nystrom.plot`` draws orbits, energy errors and work-precision charts.
 """
@@ -15,6 +16,7 @@ import numbers
 
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
+from ._flows import FlowResult, damped, flows, magnetic, rotating_frame
 from ._quantum import QuantumResult, quantum
 from ._diffusion import SmoluchowskiResult, ThermalResult, smoluchowski, thermal
 from .ensemble import ensemble
@@ -24,6 +26,7 @@ __version__ = _core.__version__  # the CMake project version, as `nystrom --vers
 
 __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
            "smoluchowski", "SmoluchowskiResult", "thermal", "ThermalResult",
+           "flows", "rotating_frame", "magnetic", "damped", "FlowResult",
            "problems", "ensemble", "plot"]
 
 

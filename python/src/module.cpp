@@ -29,6 +29,7 @@
 #include "nystrom/engines/mpe.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/plummer.hpp"
+#include "flows_binding.hpp"
 #include "solve_binding.hpp"
 #ifdef NYSTROM_PYTHON_QUANTUM
 #include "diffusion_binding.hpp"
@@ -344,6 +345,7 @@ PYBIND11_MODULE(_core, m) {
       "solve() (nystrom/solve.hpp) on a built-in problem (problem: its name) or a Python force(t, q) "
       "(problem: ''); nystrom.solve checks the arguments and wraps the result.");
 
+  register_flows(m);
 #ifdef NYSTROM_PYTHON_QUANTUM
   register_quantum(m);
   register_diffusion(m);
