@@ -13,7 +13,7 @@ layers=(
   "methods"
   "engines"
   "operators"
-  "solve quantum planetary"
+  "solve quantum planetary stochastic"
   "analysis diagnostics"
 )
 declare -A rank
