@@ -5,9 +5,10 @@
                         t_span=(0, 20 * np.pi), method="M8", steps=20000)
     res.q[-1], res.force_evals
 
-Built-in problems (``nystrom.problems``) and the split-operator Schrödinger solver (``nystrom.quantum``) run
-in C++ with the GIL released; ``nystrom.ensemble`` maps runs over a process pool, a Dask client or an MPI
-pool; ``nystrom.plot`` draws orbits, energy errors and work-precision charts.
+Built-in problems (``nystrom.problems``), the split-operator Schrödinger solver (``nystrom.quantum``) and
+Langevin path ensembles (``nystrom.langevin``) run in C++ with the GIL released; ``nystrom.ensemble`` maps runs
+over a process pool, a Dask client or an MPI pool; ``nystrom.plot`` draws orbits, energy errors and work-precision
+charts.
 """
 
 import json
@@ -16,13 +17,14 @@ import numbers
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
 from ._quantum import QuantumResult, quantum
+from ._langevin import LangevinResult, langevin
 from .ensemble import ensemble
 from . import problems
 
 __version__ = _core.__version__  # the CMake project version, as `nystrom --version` prints it
 
 __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
-           "problems", "ensemble", "plot"]
+           "langevin", "LangevinResult", "problems", "ensemble", "plot"]
 
 
 def methods():

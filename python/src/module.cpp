@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "experiments/kepler.hpp"
+#include "langevin_binding.hpp"
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/analysis/bch_report.hpp"
 #include "nystrom/analysis/method_file.hpp"
@@ -343,6 +344,7 @@ PYBIND11_MODULE(_core, m) {
       "solve() (nystrom/solve.hpp) on a built-in problem (problem: its name) or a Python force(t, q) "
       "(problem: ''); nystrom.solve checks the arguments and wraps the result.");
 
+  register_langevin(m);
 #ifdef NYSTROM_PYTHON_QUANTUM
   register_quantum(m);
 #endif
