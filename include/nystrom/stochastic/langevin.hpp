@@ -55,6 +55,10 @@ inline error error_interrupted() { return error("interrupted"); }
 /// Most members of an extrapolation sequence.
 inline constexpr std::size_t max_members = 8;
 
+/// Most paths of one run (the statistics of every chunk of 64 paths are kept until the end: about 1 kB each for
+/// five observables and three members).
+inline constexpr long max_paths = 100000000;
+
 /// Paths per chunk: the unit of work and of the deterministic reduction.
 inline constexpr long chunk_paths = 64;
 
@@ -203,7 +207,9 @@ Plan make_plan(const P& problem, const LangevinOptions& o) {
     if (!std::isfinite(problem.q0[i]) || !std::isfinite(problem.v0[i]))
       throw invalid_input("the initial state must be finite");
   if (problem.observable_names.empty()) throw invalid_input("a Langevin run needs at least one observable");
-  if (o.paths < 1) throw invalid_input("the number of paths must be positive");
+  if (o.paths < 1 || o.paths > max_paths)
+    throw invalid_input("the number of paths must be between 1 and " + std::to_string(max_paths) + ", got " +
+                        std::to_string(o.paths));
   if (o.threads < 1 || o.threads > 1024) throw invalid_input("threads must be between 1 and 1024");
   try {
     validate_mpe_sequence(o.extrapolate);
@@ -352,6 +358,12 @@ LangevinPartial run_chunk(const P& problem, const Plan& plan, std::uint64_t seed
 
 }  // namespace detail
 
+/// Checks a problem and options as a run does (throws nystrom::invalid_input with one line).
+template <class P>
+void check_langevin(const P& problem, const LangevinOptions& options) {
+  detail::make_plan(problem, options);
+}
+
 /// Runs the paths first_path .. first_path + count - 1 on options.threads threads and returns their
 /// statistics. first_path must be a multiple of chunk_paths: partial results of consecutive ranges then merge
 /// (LangevinPartial::merge, in path order) into bitwise the statistics of one run over all of them.
@@ -361,7 +373,8 @@ LangevinPartial run_langevin_paths(const P& problem, const LangevinOptions& opti
   if (first_path < 0 || first_path % chunk_paths != 0)
     throw invalid_input("a range of Langevin paths starts at a multiple of " + std::to_string(chunk_paths) + ", got " +
                         std::to_string(first_path));
-  if (count < 1) throw invalid_input("a range of Langevin paths needs at least one path");
+  if (count < 1 || count > max_paths)
+    throw invalid_input("a range of Langevin paths holds 1 to " + std::to_string(max_paths) + " paths");
   const long chunks = (count + chunk_paths - 1) / chunk_paths;
   std::vector<LangevinPartial> parts(static_cast<std::size_t>(chunks));
   std::atomic<long> next{0};
