@@ -88,8 +88,19 @@ def _progress(progress):
     raise TypeError("progress must be True, False or a callable progress(done, total)")
 
 
+_CHUNK = 64  # paths per chunk of the library's deterministic reduction (nystrom/stochastic/langevin.hpp)
+
+
+def _partial(args, first, count):
+    """One executor task: the statistics of paths first .. first + count - 1 (plain, picklable data)."""
+    from . import _core as core
+
+    return core.langevin_partial(core.LangevinRequest(*args), first, count)
+
+
 def langevin(potential="harmonic", gamma=1.0, kT=1.0, method="BAOAB", h=0.05, t_end=10.0, paths=1000,
-             extrapolate=(1,), seed=1, q0=1.0, v0=0.0, omega=1.0, threads=0, progress=False):
+             extrapolate=(1,), seed=1, q0=1.0, v0=0.0, omega=1.0, threads=0, progress=False, executor=None,
+             tasks=None):
     """Averages over ``paths`` independent Langevin paths from (q0, v0), with standard errors (as
     ``nystrom langevin``, with the same defaults).
 
@@ -121,6 +132,11 @@ def langevin(potential="harmonic", gamma=1.0, kT=1.0, method="BAOAB", h=0.05, t_
     progress : bool or callable
         True: a progress bar; a callable gets ``progress(paths_done, paths)``. Ctrl-C interrupts the run
         (KeyboardInterrupt) either way.
+    executor : optional
+        Any object with ``submit(fn, *args)`` returning futures (``concurrent.futures`` pools, a
+        ``dask.distributed.Client``, ``mpi4py.futures.MPIPoolExecutor``): the paths are split into ``tasks``
+        ranges (default: up to 32, whole chunks of 64 paths), each run there with ``threads`` threads (0: one),
+        and the statistics merged here in path order: the result is bitwise that of the run without it.
 
     Returns
     -------
@@ -153,13 +169,24 @@ def langevin(potential="harmonic", gamma=1.0, kT=1.0, method="BAOAB", h=0.05, t_
     paths = _integer("paths", paths, 1, 2**62)
     seed = _integer("seed", seed, 0, 2**64 - 1)
     threads = _integer("threads", threads, 0, 1024)
+    seq = _sequence(extrapolate)
+    if executor is not None:
+        if not callable(getattr(executor, "submit", None)):
+            raise TypeError("executor must have a submit(fn, *args) method (concurrent.futures, Dask, mpi4py)")
+        chunks = -(-paths // _CHUNK)
+        tasks = min(chunks, 32) if tasks is None else _integer("tasks", tasks, 1, 1 << 20)
+        per = -(-chunks // tasks) * _CHUNK
+        args = (potential, omega, gamma, kT, q0, v0, method, h, t_end, paths, seed, seq, threads or 1)
+        request = _core.LangevinRequest(*args)
+        _core.langevin_check(request)  # the library's checks, here, before anything is submitted
+        futures = [executor.submit(_partial, args, first, min(per, paths - first)) for first in range(0, paths, per)]
+        return LangevinResult(_core.langevin_finish(request, [f.result() for f in futures]))
     if threads == 0:
         threads = min(os.cpu_count() or 1, 64)
-    seq = _sequence(extrapolate)
+    request = _core.LangevinRequest(potential, omega, gamma, kT, q0, v0, method, h, t_end, paths, seed, seq, threads)
     update, close = _progress(progress)
     try:
-        d = _core.langevin(potential, omega, gamma, kT, q0, v0, method, h, t_end, paths, seed, seq, threads, 0,
-                           update)
+        d = _core.langevin(request, update)
     finally:
         if close is not None:
             close()

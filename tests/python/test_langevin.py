@@ -3,6 +3,8 @@ samples q exactly, <q^2> = kT / omega^2, and <v^2> = kT (1 - h^2 omega^2 / 4) at
 refusals and the thread-independence of the tool."""
 import doctest
 import inspect
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import pytest
 
@@ -39,13 +41,28 @@ def test_the_result_does_not_depend_on_the_thread_count():
         assert r.averages == runs[0].averages and r.final == runs[0].final  # exact equality of the floats
 
 
+def test_an_executor_gives_the_same_result_bitwise():
+    args = dict(potential="double-well", kT=0.5, h=0.1, t_end=4.0, paths=500, extrapolate=[1, 2], seed=3)
+    plain = nystrom.langevin(**args, threads=2)
+    with ThreadPoolExecutor(3) as pool:
+        threaded = nystrom.langevin(**args, executor=pool, tasks=5)
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        processes = nystrom.langevin(**args, executor=pool)
+    for r in (threaded, processes):
+        assert r.averages == plain.averages and r.final == plain.final and r.members == plain.members
+        assert r.force_evaluations == plain.force_evaluations
+    with ThreadPoolExecutor(1) as pool, pytest.raises(ValueError, match="'X' is not A"):
+        nystrom.langevin(method="BAXAB", executor=pool)
+
+
 def test_defaults_are_the_tools():
     sig = inspect.signature(nystrom.langevin)
     defaults = {k: v.default for k, v in sig.parameters.items()}
     # `nystrom langevin --help`: harmonic, gamma 1, kT 1, BAOAB, h 0.05, t-end 10, paths 1000, extrapolate 1,
     # seed 1, q0 1, v0 0, omega 1, threads 0
     assert defaults == dict(potential="harmonic", gamma=1.0, kT=1.0, method="BAOAB", h=0.05, t_end=10.0, paths=1000,
-                            extrapolate=(1,), seed=1, q0=1.0, v0=0.0, omega=1.0, threads=0, progress=False)
+                            extrapolate=(1,), seed=1, q0=1.0, v0=0.0, omega=1.0, threads=0, progress=False,
+                            executor=None, tasks=None)
 
 
 @pytest.mark.parametrize("kwargs,message", [
