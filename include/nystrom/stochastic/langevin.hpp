@@ -379,7 +379,7 @@ LangevinPartial run_langevin_paths(const P& problem, const LangevinOptions& opti
   std::vector<LangevinPartial> parts(static_cast<std::size_t>(chunks));
   std::atomic<long> next{0};
   std::atomic<bool> failed{false};
-  std::exception_ptr error;
+  std::exception_ptr failure;
   std::mutex mutex;
   long done = 0;
   const auto work = [&] {
@@ -398,7 +398,7 @@ LangevinPartial run_langevin_paths(const P& problem, const LangevinOptions& opti
         }
       } catch (...) {
         const std::lock_guard lock(mutex);
-        if (!error) error = std::current_exception();
+        if (!failure) failure = std::current_exception();
         failed = true;
         return;
       }
@@ -412,7 +412,7 @@ LangevinPartial run_langevin_paths(const P& problem, const LangevinOptions& opti
     for (int t = 0; t < threads; ++t) pool.emplace_back(work);
     for (auto& t : pool) t.join();
   }
-  if (error) std::rethrow_exception(error);
+  if (failure) std::rethrow_exception(failure);
   LangevinPartial all;
   for (const auto& p : parts) all.merge(p);
   return all;
