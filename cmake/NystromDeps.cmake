@@ -1,6 +1,7 @@
 # Dependencies of the header-only library, all from Debian's archive:
 #   Boost (Multiprecision), GMP + gmpxx (exact MPE coefficients), MPFR (reference precision),
-#   libquadmath (float128), libqd (double-double, quad-double).
+#   libquadmath (float128), libqd (double-double, quad-double), Random123 (counter-based random numbers of
+#   the Langevin paths, header-only).
 include_guard(GLOBAL)
 find_package(Boost 1.74 REQUIRED)
 find_path(GMPXX_INCLUDE_DIR gmpxx.h REQUIRED)
@@ -10,9 +11,11 @@ find_path(MPFR_INCLUDE_DIR mpfr.h REQUIRED)
 find_library(MPFR_LIBRARY mpfr REQUIRED)
 find_path(QD_INCLUDE_DIR qd/dd_real.h REQUIRED)
 find_library(QD_LIBRARY qd REQUIRED)
+find_path(RANDOM123_INCLUDE_DIR Random123/philox.h REQUIRED)
 if(NOT TARGET nystrom_deps)
   add_library(nystrom_deps INTERFACE)
-  target_include_directories(nystrom_deps INTERFACE ${GMPXX_INCLUDE_DIR} ${MPFR_INCLUDE_DIR} ${QD_INCLUDE_DIR})
+  target_include_directories(nystrom_deps INTERFACE ${GMPXX_INCLUDE_DIR} ${MPFR_INCLUDE_DIR} ${QD_INCLUDE_DIR}
+                                                    ${RANDOM123_INCLUDE_DIR})
   # libquadmath ships with GCC (not in the default library path): link it by name.
   target_link_libraries(nystrom_deps INTERFACE Boost::headers ${QD_LIBRARY} ${MPFR_LIBRARY} ${GMPXX_LIBRARY}
                                                 ${GMP_LIBRARY} quadmath)

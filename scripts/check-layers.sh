@@ -13,7 +13,7 @@ layers=(
   "methods"
   "engines"
   "operators"
-  "solve quantum planetary velocity"
+  "solve quantum planetary velocity stochastic"
   "analysis diagnostics"
 )
 declare -A rank

@@ -3,7 +3,7 @@
 # Does nothing when everything is already installed.
 set -euo pipefail
 packages=(g++ cmake make pkg-config libgtest-dev libbenchmark-dev libboost-dev libgmp-dev libmpfr-dev
-          libqd-dev libcli11-dev nlohmann-json3-dev libfmt-dev gnuplot-nox
+          libqd-dev librandom123-dev libcli11-dev nlohmann-json3-dev libfmt-dev gnuplot-nox
           libfftw3-dev libfftw3-mpi-dev libopenmpi-dev openmpi-bin
           python3-dev pybind11-dev python3-numpy python3-pytest python3-scipy python3-matplotlib
           python3-distributed python3-mpi4py python3-pip python3-venv python3-setuptools python3-wheel

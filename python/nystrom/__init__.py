@@ -6,9 +6,10 @@
     res.q[-1], res.force_evals
 
 Built-in problems (``nystrom.problems``), the exact velocity-dependent flows (``nystrom.flows``: a rotating
-frame, a magnetic field, friction) and the split-operator Schrödinger solver (``nystrom.quantum``) run
-in C++ with the GIL released; ``nystrom.ensemble`` maps runs over a process pool, a Dask client or an MPI
-pool; ``nystrom.plot`` draws orbits, energy errors and work-precision charts.
+frame, a magnetic field, friction), the split-operator Schrödinger solver (``nystrom.quantum``), diffusion
+(``nystrom.smoluchowski``, ``nystrom.thermal``) and Langevin path ensembles (``nystrom.langevin``) run in C++
+with the GIL released; ``nystrom.ensemble`` maps runs over a process pool, a Dask client or an MPI pool;
+``nystrom.plot`` draws orbits, energy errors and work-precision charts.
 """
 
 import json
@@ -19,6 +20,7 @@ from ._solve import DenseSolution, OdeResult, solve
 from ._flows import FlowResult, damped, flows, magnetic, rotating_frame
 from ._quantum import QuantumResult, quantum
 from ._diffusion import SmoluchowskiResult, ThermalResult, smoluchowski, thermal
+from ._langevin import LangevinResult, langevin
 from .ensemble import ensemble
 from . import problems
 
@@ -27,7 +29,7 @@ __version__ = _core.__version__  # the CMake project version, as `nystrom --vers
 __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
            "smoluchowski", "SmoluchowskiResult", "thermal", "ThermalResult",
            "flows", "rotating_frame", "magnetic", "damped", "FlowResult",
-           "problems", "ensemble", "plot"]
+           "langevin", "LangevinResult", "problems", "ensemble", "plot"]
 
 
 def methods():

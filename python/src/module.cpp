@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "experiments/kepler.hpp"
+#include "langevin_binding.hpp"
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/analysis/bch_report.hpp"
 #include "nystrom/analysis/method_file.hpp"
@@ -346,6 +347,7 @@ PYBIND11_MODULE(_core, m) {
       "(problem: ''); nystrom.solve checks the arguments and wraps the result.");
 
   register_flows(m);
+  register_langevin(m);
 #ifdef NYSTROM_PYTHON_QUANTUM
   register_quantum(m);
   register_diffusion(m);

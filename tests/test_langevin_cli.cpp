@@ -1,0 +1,104 @@
+// The `nystrom langevin` contract: the JSON object (averages of q2 and q4 with standard errors), its values
+// against quadrature of the Boltzmann density, the same numbers for any thread count, and bad input (exit
+// code 2, one line `nystrom: error: ...`). The tool is found through NYSTROM_BIN.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+
+namespace {
+
+using namespace cli_test;
+
+// The contract's command with fewer paths (the contract itself: --paths 10000).
+const std::string kCommand =
+    "langevin --potential double-well --gamma 1 --kT 0.5 --method BAOAB --h 0.05 --paths 600 --t-end 100 "
+    "--extrapolate 1,2,3 --seed 1 --json";
+
+// <q^2>, <q^4> of exp(-(q^2 - 1)^2 / kT) by Simpson's rule on [-4, 4].
+std::pair<double, double> boltzmann_moments(double kT) {
+  double z = 0, m2 = 0, m4 = 0;
+  const int n = 4000;
+  for (int i = 0; i <= n; ++i) {
+    const double q = -4 + 8.0 * i / n, u = (q * q - 1) * (q * q - 1);
+    const double rho = ((i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2)) * std::exp(-u / kT);
+    z += rho, m2 += rho * q * q, m4 += rho * q * q * q * q;
+  }
+  return {m2 / z, m4 / z};
+}
+
+}  // namespace
+
+TEST(LangevinCli, ContractJsonAgreesWithTheBoltzmannDensityForAnyThreadCount) {
+  const auto one = run(kCommand + " --threads 1");
+  ASSERT_EQ(one.code, 0) << one.err;
+  const auto j = nlohmann::json::parse(one.out);
+  const auto [m2, m4] = boltzmann_moments(0.5);
+  for (const auto& [name, exact] : {std::pair{"q2", m2}, std::pair{"q4", m4}}) {
+    const auto& e = j.at("averages").at(name);
+    const double value = e.at("value").get<double>(), se = e.at("stderr").get<double>();
+    EXPECT_GT(se, 0) << name;
+    EXPECT_LT(se, 0.01) << name;
+    EXPECT_LE(std::abs(value - exact), 5 * se) << name << " " << value << " +- " << se << " vs " << exact;
+  }
+  EXPECT_EQ(j.at("extrapolate"), nlohmann::json({1, 2, 3}));
+  EXPECT_EQ(j.at("order").get<int>(), 6);
+  EXPECT_EQ(j.at("members").size(), 3u);
+  EXPECT_EQ(j.at("steps").get<long>(), 2000);
+  EXPECT_EQ(j.at("window"), nlohmann::json({50.0, 100.0}));
+  // BAOAB: one force per step and the first, for each of the three runs
+  EXPECT_EQ(j.at("force_evaluations").get<long long>(), 600LL * (2000 + 4000 + 6000 + 3));
+  for (const char* threads : {"2", "3"}) {
+    const auto other = run(kCommand + " --threads " + threads);
+    ASSERT_EQ(other.code, 0) << other.err;
+    EXPECT_EQ(other.out, one.out) << "--threads " << threads;  // the same text: the same numbers
+  }
+}
+
+TEST(LangevinCli, ExtrapolateOneIsTheSchemeAlone) {
+  const auto r = run("langevin --potential harmonic --kT 0.5 --h 0.5 --t-end 100 --paths 300 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("coefficients"), nlohmann::json({1.0}));
+  // BAOAB at h omega = 1/2: <q^2> = kT exactly, <v^2> = kT (1 - 1/16)
+  const auto& q2 = j.at("averages").at("q2");
+  const auto& v2 = j.at("averages").at("v2");
+  EXPECT_LE(std::abs(q2.at("value").get<double>() - 0.5), 5 * q2.at("stderr").get<double>());
+  EXPECT_LE(std::abs(v2.at("value").get<double>() - 0.5 * 15 / 16), 5 * v2.at("stderr").get<double>());
+}
+
+TEST(LangevinCli, TextOutputNamesTheEstimates) {
+  const auto r = run("langevin --paths 50 --t-end 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"BAOAB", "q2", "q4", "v2", "energy", "+-"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+}
+
+TEST(LangevinCli, BadInputIsOneLineAndExitTwo) {
+  for (const char* args : {
+           "langevin --method BAXAB",
+           "langevin --method BAO --extrapolate 1,2",
+           "langevin --potential quartic",
+           "langevin --h 0.3 --t-end 1",
+           "langevin --h 0",
+           "langevin --h nan",
+           "langevin --gamma -1",
+           "langevin --kT -0.5",
+           "langevin --paths 0",
+           "langevin --extrapolate 1,1",
+           "langevin --extrapolate 0",
+           "langevin --extrapolate 1,x",
+           "langevin --threads -1",
+           "langevin --potential harmonic --omega 10 --gamma 0.01 --h 0.5 --t-end 100 --paths 10",
+       }) {
+    const auto r = run(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out << r.err;
+    EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << args << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+  }
+}
