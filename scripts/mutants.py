@@ -75,23 +75,30 @@ FILE_LAYER = [
     ("include/nystrom/core/", "core"),
 ]
 LAYERS = {
-    "engines": ["test_engines", "test_compensated", "test_mpe_schedule", "test_mpe_combination", "test_carry"],
-    "adaptive_rkn": ["test_adaptive_rkn", "test_adaptive_cost", "test_solve"],
-    "adaptive_mpe": ["test_adaptive_mpe", "test_adaptive_cost", "test_solve"],
-    "gbs": ["test_gbs", "test_adaptive_cost"],
-    "solve": ["test_solve", "test_dense", "test_compiled", "test_solve_directions"],
-    "checkpoint": ["test_solve", "test_files", "test_solve_directions"],
+    "engines": ["test_engines", "test_compensated", "test_carry", "test_engine_edges"],
+    "adaptive_rkn": ["test_adaptive_rkn", "test_adaptive_cost", "test_carry", "test_solve_directions"],
+    "adaptive_mpe": ["test_adaptive_mpe", "test_adaptive_cost", "test_carry", "test_solve_directions"],
+    "gbs": ["test_gbs", "test_adaptive_cost", "test_engine_edges", "test_solve_directions"],
+    "solve": ["test_solve", "test_dense", "test_solve_directions"],
+    "checkpoint": ["test_solve", "test_solve_directions", "test_files"],
     "odeint": ["test_solve_odeint"],
-    "catalog": ["test_engines", "test_properties", "test_catalog_tables"],
+    "catalog": ["test_engines", "test_properties"],
     "operators": ["test_operators"],
     "quantum": ["test_quantum"],
     "planetary": ["test_planetary"],
     "files": ["test_files"],
-    "core": ["test_precision", "test_compensated", "test_engines", "test_carry"],
+    "core": ["test_precision", "test_compensated", "test_carry"],
 }
 
 # Survivors shown equivalent: (file, line text stripped, mutated text stripped) -> the reason.
-EQUIVALENT = {}
+EQUIVALENT = {
+    ("include/nystrom/engines/mpe.hpp", "bool lockstep_ = false, concurrent_ = false;",
+     "bool lockstep_ = false, concurrent_ = true;"):
+    "the only constructor assigns concurrent_ before any use: the default member initializer is never read",
+    ("include/nystrom/engines/adaptive_rkn.hpp", "hmax_ = opt.h_max > 0 ? std::min(span, R(opt.h_max)) : span;",
+     "hmax_ = opt.h_max > 0 ? std::min(R(opt.h_max), span) : span;"):
+    "std::min of two finite values (AdaptiveOptions::validate) is the same value in either order",
+}
 
 
 def layer_of(path):
@@ -352,7 +359,7 @@ def run(cmd, log, timeout=None, cwd=None):
         return "timeout", time.time() - t0
 
 
-def summarize(results, build, args, allsites, final):
+def summarize(results, build, args, allsites, final, name="report"):
     """Writes the report (after every mutant, so that a stopped run keeps what it measured)."""
     killed = sum(r["verdict"] == "killed" for r in results)
     equivalent = sum(r["verdict"] == "equivalent" for r in results)
@@ -363,7 +370,8 @@ def summarize(results, build, args, allsites, final):
     report = {"seed": args.seed, "count": args.count, "sites": len(allsites), "killed": killed,
               "compiled": compiled, "equivalent": equivalent, "does_not_compile": invalid, "not_run": notrun,
               "mutants": results}
-    out = os.path.join(build, f"report-{args.seed}.json")
+    os.makedirs(build, exist_ok=True)
+    out = os.path.join(build, f"{name}-{args.seed}.json")
     with open(out + ".tmp", "w") as f:
         json.dump(report, f, indent=1)
     os.replace(out + ".tmp", out)
@@ -388,9 +396,41 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--max-seconds", type=float, default=0,
                     help="stop starting mutants after this many seconds (those not run are reported)")
+    ap.add_argument("--lib-solve", default="double",
+                    help="the lib/solve_<type>.cpp the scratch library compiles (comma-separated, or none)")
+    ap.add_argument("--without", default="", help="comma-separated test programs to leave out of every layer")
     ap.add_argument("--keep-src", action="store_true", help="reuse the copy of the sources as it is")
+    ap.add_argument("--report", nargs="+", metavar="JSON",
+                    help="merge these reports of one seed (e.g. two runs of disjoint --only sets) and summarise them "
+                         "with today's EQUIVALENT table; builds nothing")
     args = ap.parse_args()
     os.chdir(ROOT)
+    if args.report:
+        results, allsites = {}, []
+        for path in args.report:
+            with open(path) as f:
+                rep = json.load(f)
+            if rep["seed"] != args.seed:
+                raise SystemExit(f"mutants: {path} is of seed {rep['seed']}, not {args.seed}")
+            allsites = range(rep["sites"])
+            for r in rep["mutants"]:
+                if r["verdict"] != "not run":
+                    results[r["number"]] = r
+        merged = []
+        for n in sorted(results):
+            r = results[n]
+            key = (r["file"], r["before"], r["after"])
+            if r["verdict"] in ("survived", "equivalent"):
+                r["verdict"] = "equivalent" if key in EQUIVALENT else "survived"
+                if key in EQUIVALENT:
+                    r["reason"] = EQUIVALENT[key]
+            merged.append(r)
+        for r in merged:
+            if r["verdict"] == "equivalent":
+                print(f"equivalent {r['number']}: {r['file']}:{r['line']} '{r['before']}' -> '{r['after']}': {r['reason']}")
+        args.build = os.path.abspath(args.build)
+        survived, _ = summarize(merged, args.build, args, allsites, final=True, name="merged")
+        return 1 if survived else 0
     layers = set(args.layers.split(",")) if args.layers else None
     if layers and not layers <= set(LAYERS):
         raise SystemExit(f"mutants: unknown layer in {args.layers} (layers: {', '.join(sorted(LAYERS))})")
@@ -429,13 +469,15 @@ def main():
                 os.makedirs(os.path.dirname(dst), exist_ok=True)
             with open(dst, "wb") as f:
                 f.write(data)
-        # The layers' programs call solve() on double and long double only: the scratch library compiles those
-        # two instantiations (lib/solve_<type>.cpp), which halves the cost of a mutant in a header of the
-        # drivers or engines. A program that needs another would fail to link in the unmutated build.
+        # The layers' programs call the compiled solve() on std::vector<double> only: the scratch library
+        # compiles that instantiation alone (lib/solve_double.cpp; --lib-solve), a sixth of the cost of a mutant
+        # in a header of the drivers or engines. A program that needs another fails to link in the unmutated
+        # build, which stops the run.
         cm = os.path.join(src, "CMakeLists.txt")
         with open(cm) as f:
             text = f.read()
-        text2 = re.sub(r"\s*lib/solve_(float128|dd|qd|mpfr)\.cpp", "", text)
+        keep = args.lib_solve.split(",") if args.lib_solve != "none" else []
+        text2 = re.sub(r"\s*lib/solve_(\w+)\.cpp", lambda mo: mo.group(0) if mo.group(1) in keep else "", text)
         if text2 != text:
             with open(cm, "w") as f:
                 f.write(text2)
@@ -450,7 +492,7 @@ def main():
     if rc != 0:
         raise SystemExit(f"mutants: cmake failed (log: {log_path})")
     available = set(n[:-4] for n in os.listdir(os.path.join(src, "tests")) if n.startswith("test_") and
-                    n.endswith(".cpp"))
+                    n.endswith(".cpp")) - set(args.without.split(","))
 
     def build_targets(targets):
         return run(["cmake", "--build", obj, "-j", str(args.jobs), "--target", *targets], log)[0] == 0
