@@ -276,3 +276,29 @@ TEST(SolveDirections, ACheckpointDueInTheLastStepIsNotTakenAndChangesNothing) {
     }
   }
 }
+
+TEST(SolveDirections, TimeDependentForceEitherWay) {
+  // q'' = -q + cos 2t from rest at 0: q = (cos t - cos 2t) / 3, v = (2 sin 2t - sin t) / 3; the engines carry t as
+  // a coordinate (GBS sets it exactly at every substep), backward on the time-reversed problem.
+  const std::function<void(double, const Vd&, Vd&)> f = [](double t, const Vd& q, Vd& a) {
+    a[0] = -q[0] + std::cos(2 * t);
+  };
+  const auto qx = [](double t) { return (std::cos(t) - std::cos(2 * t)) / 3; };
+  const auto vx = [](double t) { return (2 * std::sin(2 * t) - std::sin(t)) / 3; };
+  for (int dir : {1, -1}) {
+    const double t0 = dir > 0 ? 0.0 : 5.0, t1 = 5.0 - t0;
+    const SecondOrderProblem prob(f, Vd{qx(t0)}, Vd{vx(t0)}, t0, t1);
+    std::vector<double> te;
+    for (int i = 1; i <= 10; ++i) te.push_back(t0 + dir * 0.5 * i);
+    for (auto c : cases()) {
+      SCOPED_TRACE(c.method + (dir > 0 ? " forward" : " backward"));
+      c.opt.t_eval = te;
+      const auto sol = solve(prob, c.method, c.opt);
+      ASSERT_EQ(sol.t.size(), te.size());
+      for (std::size_t i = 0; i < te.size(); ++i) {
+        EXPECT_NEAR(sol.q[i][0], qx(te[i]), 1e-9) << te[i];
+        EXPECT_NEAR(sol.v[i][0], vx(te[i]), 1e-9) << te[i];
+      }
+    }
+  }
+}
