@@ -82,12 +82,12 @@ LAYERS = {
     "solve": ["test_solve", "test_dense", "test_solve_directions"],
     "checkpoint": ["test_solve", "test_solve_directions", "test_files"],
     "odeint": ["test_solve_odeint"],
-    "catalog": ["test_engines", "test_properties"],
+    "catalog": ["test_engines", "test_properties", "test_catalog_specs"],
     "operators": ["test_operators"],
     "quantum": ["test_quantum"],
-    "planetary": ["test_planetary"],
+    "planetary": ["test_planetary", "test_engine_edges"],
     "files": ["test_files"],
-    "core": ["test_precision", "test_compensated", "test_carry"],
+    "core": ["test_precision", "test_compensated", "test_carry", "test_engine_edges"],
 }
 
 # Survivors shown equivalent: (file, line text stripped, mutated text stripped) -> the reason.
@@ -391,6 +391,8 @@ def main():
     ap.add_argument("--count", type=int, default=60)
     ap.add_argument("--layers", help="comma-separated layers to sample from (default: all)")
     ap.add_argument("--only", help="comma-separated 1-based numbers of the sample to run")
+    ap.add_argument("--run-layers", help="run only the mutants of the sample in these layers (comma-separated; the "
+                                         "sample is the same as without it)")
     ap.add_argument("--list", action="store_true", help="print the sample, build nothing")
     ap.add_argument("--build", default=os.environ.get("NYSTROM_MUTANTS_DIR", "build/mutants"))
     ap.add_argument("--jobs", type=int, default=2)
@@ -443,6 +445,8 @@ def main():
                   f"      + {d['after']}")
         return 0
     only = [int(x) for x in args.only.split(",")] if args.only else range(1, len(picked) + 1)
+    if args.run_layers:
+        only = [i for i in only if muts[i - 1]["layer"] in args.run_layers.split(",")]
     t_start = time.time()
 
     build = os.path.abspath(args.build)

@@ -1,14 +1,19 @@
 // The documented thresholds of the engines, on both sides of each: the rounding amplification at which a
-// multi-product expansion is refused for a scalar type, and the sliver below which GBS ends its span in one step.
+// multi-product expansion is refused for a scalar type, the sliver below which GBS ends its span in one step, the
+// bounds of an MPFR precision; the energy of a planetary system on a case computed by hand.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "nystrom/core/extended.hpp"
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/engines/integrator.hpp"
+#include "nystrom/planetary/system.hpp"
+#include "nystrom/planetary/wisdom_holman.hpp"
 
 using namespace nystrom;
 
@@ -59,5 +64,35 @@ TEST(EngineEdges, GbsTakesTheRestOfItsSpanInOneStepOnlyWithinOneMillionth) {
     EXPECT_EQ(g.steps(), x <= 1e-6 ? 1 : 2);
     EXPECT_NEAR(s.q[0], std::cos(1.0), 1e-5);
     EXPECT_NEAR(s.v[0], -std::sin(1.0), 1e-5);
+  }
+}
+
+TEST(EngineEdges, MpfrPrecisionIsAcceptedUpToItsBoundsInclusive) {
+  EXPECT_EQ(parse_mpfr_bits(std::to_string(MpfrPrecision::min_bits)), MpfrPrecision::min_bits);
+  EXPECT_EQ(parse_mpfr_bits(std::to_string(MpfrPrecision::max_bits)), MpfrPrecision::max_bits);
+  EXPECT_THROW(parse_mpfr_bits(std::to_string(MpfrPrecision::min_bits - 1)), std::invalid_argument);
+  EXPECT_THROW(parse_mpfr_bits(std::to_string(MpfrPrecision::max_bits + 1)), std::invalid_argument);
+}
+
+TEST(EngineEdges, PlanetaryEnergyOfTwoBodiesIsTheAnalyticOne) {
+  // E = m1 |v1|^2 / 2 + m2 |v2|^2 / 2 - G m1 m2 / r: G = 2, m = (1, 0.5), r = |(1, 2, 2)| = 3,
+  // |v1|^2 = 0.01 + 0.04, |v2|^2 = 0.09 + 0.09 + 0.16: E = 0.025 + 0.085 - 1/3.
+  using planetary::Vec3;
+  const std::vector<double> m = {1.0, 0.5};
+  const std::vector<Vec3<double>> x = {{0.5, 0.5, 0.5}, {1.5, 2.5, 2.5}};
+  const std::vector<Vec3<double>> v = {{0.0, 0.1, 0.2}, {0.3, -0.3, 0.4}};
+  EXPECT_NEAR(planetary::energy(2.0, m, x, v), 0.025 + 0.085 - 1.0 / 3, 1e-15);
+}
+
+TEST(EngineEdges, WisdomHolmanMapsAreOfSecondOrder) {
+  // The map, and the map with a symplectic corrector of any order n (error O(eps h^(n+1) + eps^2 h^2)), are of
+  // order 2 in h (Wisdom, Holman & Touma 1996); both are symmetric and symplectic.
+  for (const std::string m : {"WH", "WHC3", "WHC17"}) {
+    SCOPED_TRACE(m);
+    const auto fm = planetary::resolve_wh_method(m, 53, "double");
+    EXPECT_EQ(fm.info.order, 2);
+    EXPECT_TRUE(fm.info.symmetric);
+    EXPECT_TRUE(fm.info.symplectic);
+    EXPECT_EQ(fm.info.forces_per_step, 1);
   }
 }
