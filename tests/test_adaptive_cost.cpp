@@ -288,3 +288,25 @@ TEST(AdaptiveController, StepSequenceLandsOnTheEndAndStretchesTheLastPercent) {
   ASSERT_TRUE(seq.next<false>(0.0, h, last));
   EXPECT_DOUBLE_EQ(h, 0.54 * 0.45);
 }
+
+TEST(AdaptiveCost, NearRoundingTheStepsFollowTheOrderNotTheNoise) {
+  // M16-adaptive (p = 14) on Kepler e = 0.5 over 100 periods: from tol 1e-12 to 3.2e-15 (within 15 eps of double)
+  // the accepted steps grow at most by (1e-12 / 3.2e-15)^(1/15) = 1.47 (plus 10%); an estimate whose round-off
+  // the controller chases instead takes several times more.
+  const VdForce kepler = [](const Vd& q, Vd& a) {
+    const double r2 = q[0] * q[0] + q[1] * q[1], r3 = r2 * std::sqrt(r2);
+    a[0] = -q[0] / r3;
+    a[1] = -q[1] / r3;
+  };
+  const double T = 100 * 2 * 3.14159265358979323846;
+  const SecondOrderProblem prob(kepler, Vd{1.5, 0.0}, Vd{0.0, std::sqrt(1.0 / 3.0)}, 0.0, T);
+  const auto loose = solve(prob, "M16-adaptive", {.rtol = 1e-12});
+  const auto tight = solve(prob, "M16-adaptive", {.rtol = 3.2e-15});
+  const double bound = 1.1 * static_cast<double>(loose.accepted) * std::pow(1e-12 / 3.2e-15, 1.0 / 15);
+  EXPECT_LE(static_cast<double>(tight.accepted), bound) << loose.accepted << " -> " << tight.accepted;
+  EXPECT_GE(tight.accepted, loose.accepted);
+  EXPECT_LE(4 * tight.rejected, tight.accepted);
+  // Back at the apocentre (1.5, 0) after whole periods, at the accuracy the tolerance allows.
+  EXPECT_NEAR(tight.q_final[0], 1.5, 1e-9);
+  EXPECT_NEAR(tight.v_final[1], std::sqrt(1.0 / 3.0), 1e-9);
+}
