@@ -110,6 +110,11 @@ TEST(SolveDirections, DenseOutputHasTheAnalyticPositionsAndVelocitiesInsideTheSt
         const auto s = sol(t);
         expect_exact(t, s.q[0], s.v[0], tol);
       }
+      // At both ends: the initial state and the final one.
+      const double t0 = dir > 0 ? 0.0 : T, t1 = T - t0;
+      expect_exact(t0, sol(t0).q[0], sol(t0).v[0], 1e-15);
+      EXPECT_EQ(sol(t1).q, sol.q_final);
+      EXPECT_EQ(sol(t1).v, sol.v_final);
       EXPECT_THROW(sol(dir > 0 ? 7.5 : -0.5), invalid_input);
       EXPECT_THROW(sol(dir > 0 ? -0.5 : 7.5), invalid_input);
     }
