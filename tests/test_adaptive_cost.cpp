@@ -310,3 +310,17 @@ TEST(AdaptiveCost, NearRoundingTheStepsFollowTheOrderNotTheNoise) {
   EXPECT_NEAR(tight.q_final[0], 1.5, 1e-9);
   EXPECT_NEAR(tight.v_final[1], std::sqrt(1.0 / 3.0), 1e-9);
 }
+
+TEST(AdaptiveCost, GbsOrderControlIsCompetitiveWithDp12) {
+  // An extrapolation code with order control (HNW I, II.9) picks the order whose work per unit step is least:
+  // on the harmonic oscillator at tol 1e-8 and 1e-12 it must cost no more than twice the force evaluations of
+  // the order-12 Runge-Kutta-Nystrom pair, and reach the same accuracy.
+  for (double tol : {1e-8, 1e-12}) {
+    SCOPED_TRACE(tol);
+    const auto prob = oscillator_problem(100.0);
+    const auto gbs = solve(prob, "GBS", {.rtol = tol});
+    const auto dp = solve(prob, "DP12-adaptive", {.rtol = tol});
+    EXPECT_LE(gbs.force_evals, 2 * dp.force_evals) << "DP12 " << dp.force_evals;
+    EXPECT_NEAR(gbs.q_final[0], std::cos(100.0), 1e3 * tol);
+  }
+}
