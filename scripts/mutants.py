@@ -21,7 +21,8 @@ pointer and a comparison `<` from a template bracket):
     negate   the condition of an if or while negated: if (c) -> if (!(c))
 
 Each mutant is applied to a copy of the sources (build/mutants/src, never the working tree), and the test
-programs of the mutated file's layer (LAYERS below) are rebuilt and run whole, without a filter, each with
+programs of the mutated file's layer (LAYERS below) are rebuilt (with libstdc++'s assertions, so that an
+index out of bounds stops the program as the sanitizer build of CI would) and run whole, without a filter, each with
 a time limit (five times its unmutated time, at least 60 s). A mutant that does not compile is skipped and
 counted apart; it is killed when one of its programs fails or runs out of time. Before the first mutant the
 unmutated programs must pass. The build is -O0 without precompiled headers (build/mutants/obj, ccache when
@@ -41,6 +42,7 @@ import os
 import random
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -411,6 +413,8 @@ def main():
                          "with today's EQUIVALENT table; builds nothing")
     args = ap.parse_args()
     os.chdir(ROOT)
+    # A stop (Ctrl-C or kill) still restores the mutated file of the copy (the finally below).
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     if args.report:
         results, allsites = {}, []
         for path in args.report:
@@ -489,7 +493,7 @@ def main():
         if text2 != text:
             with open(cm, "w") as f:
                 f.write(text2)
-    cfg = ["cmake", "-S", src, "-B", obj, "-DCMAKE_BUILD_TYPE=Release", "-DCMAKE_CXX_FLAGS_RELEASE=-O0",
+    cfg = ["cmake", "-S", src, "-B", obj, "-DCMAKE_BUILD_TYPE=Release", "-DCMAKE_CXX_FLAGS_RELEASE=-O0 -D_GLIBCXX_ASSERTIONS",
            "-DNYSTROM_PCH=OFF", "-DNYSTROM_BUILD_TESTS=ON", "-DNYSTROM_TEST_SCOPE=library",
            "-DNYSTROM_BUILD_TOOL=OFF", "-DNYSTROM_BUILD_BENCH=OFF", "-DNYSTROM_BUILD_EXAMPLES=OFF"]
     if shutil.which("ninja"):
