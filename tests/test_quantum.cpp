@@ -630,3 +630,16 @@ TEST(QuantumImaginaryTime, EachExcitedStateCostsTheStepsOfTheGroundState) {
   EXPECT_NEAR(static_cast<double>(two.fft_count - one.fft_count), static_cast<double>(one.fft_count),
               0.05 * static_cast<double>(one.fft_count));
 }
+
+// A heartbeat without its cadence is refused, as with a cadence of 0: no default cadence is chosen silently.
+TEST(QuantumSolve, AHeartbeatNeedsItsCadence) {
+  QuantumProblem<double> p;
+  p.grid = 16;
+  p.heartbeat = [](long, long) {};
+  EXPECT_THROW(solve(p, "Y4", 0.05, 4), std::invalid_argument);
+  p.heartbeat_steps = 2;
+  long beats = 0;
+  p.heartbeat = [&](long, long) { ++beats; };
+  solve(p, "Y4", 0.05, 4);
+  EXPECT_EQ(beats, 2);
+}
