@@ -12,6 +12,7 @@
 #include "nystrom/core/extended.hpp"
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/engines/integrator.hpp"
+#include "nystrom/planetary/democratic.hpp"
 #include "nystrom/planetary/system.hpp"
 #include "nystrom/planetary/wisdom_holman.hpp"
 
@@ -95,4 +96,19 @@ TEST(EngineEdges, WisdomHolmanMapsAreOfSecondOrder) {
     EXPECT_TRUE(fm.info.symplectic);
     EXPECT_EQ(fm.info.forces_per_step, 1);
   }
+}
+
+TEST(EngineEdges, DemocraticHeliocentricCoordinatesRoundTrip) {
+  // The inertial positions and velocities come back from the democratic heliocentric state (to rounding), not
+  // merely their differences: a uniform shift of every body would leave the dynamics unchanged.
+  const auto sys = planetary::outer_solar_system<double>();
+  const auto s = planetary::to_democratic(sys);
+  std::vector<planetary::Vec3<double>> x, v;
+  planetary::from_democratic(sys.mass, s, x, v);
+  ASSERT_EQ(x.size(), sys.x.size());
+  for (std::size_t i = 0; i < x.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(x[i][k], sys.x[i][k], 1e-13) << i << " " << k;
+      EXPECT_NEAR(v[i][k], sys.v[i][k], 1e-15) << i << " " << k;
+    }
 }
