@@ -4,7 +4,7 @@
 # as errors and run the tests that need the optimised build there (the tool's tests, the Python tests, the install
 # check); build the tool, every C++ test and the libFuzzer harnesses with clang-14 under AddressSanitizer + UBSan
 # (leak detection on), run the whole C++ suite there (the library's test programs are built only there) and each
-# harness for a fixed time.
+# harness for a fixed time; a small fixed sample of mechanically generated mutants (scripts/mutants.py).
 # NYSTROM_FUZZ_SECONDS: seconds per fuzzer (default 20).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -33,6 +33,15 @@ cmake --build --preset asan-fuzz -j "$jobs"
 # of the adaptive engines (the rounding of GCC's -O3 build is the one they assert, and at -O0 they take minutes)
 # and the quick reproduction of both papers (5 s in Release, about 290 s at -O0 under the sanitizers).
 ctest --preset asan-fuzz -j "$jobs" -E '^(test_bench_peers|AdaptiveFloorCli\..*|Reproduce\.AllQuick.*)$'
+echo "   ($(( $(date +%s) - start )) s so far)"
+
+echo "== Mutation sample: 3 mechanically generated mutants (scripts/mutants.py, seed 35), about 3 minutes"
+# A fixed sample of the operator and planetary layers, whose test programs link no compiled solve() (the
+# scratch library is the catalog alone): each mutant is rebuilt at -O0 in build/mutants-ci and its layer's
+# programs run whole. Fails when a mutant that compiles survives and is not listed as equivalent in the script;
+# no mutant is started after 170 s.
+python3 scripts/mutants.py --seed 35 --count 3 --layers operators,planetary --lib-solve none --max-seconds 170 \
+  --build build/mutants-ci --jobs "$jobs"
 echo "   ($(( $(date +%s) - start )) s so far)"
 
 echo "== libFuzzer harnesses (ASan + UBSan), ${NYSTROM_FUZZ_SECONDS:-20} s each"

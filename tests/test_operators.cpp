@@ -269,3 +269,20 @@ TEST(OperatorEngine, DriftKickFlowsRunTheClassicalMethods) {
   State<V> s = p.initial_state();
   EXPECT_THROW(complex_method.integrate(flows, s, h, 1), std::invalid_argument);
 }
+
+// The counts applications() declares are those the flows receive, for splittings and multi-product expansions,
+// over one step and over many.
+TEST(OperatorEngine, DeclaredApplicationsAreTheFlowsCalls) {
+  for (const std::string spec : {"PV", "FR", "M4", "M6", "mpe-vv:1,2,3"}) {
+    for (long n : {1L, 7L}) {
+      SCOPED_TRACE(spec + " n = " + std::to_string(n));
+      MatrixFlows f = random_pair();
+      FlowIntegrator<MatrixFlows> integ(flow(spec));
+      std::vector<C> s{C(1), C(0), C(0), C(0)};
+      integ.integrate(f, s, 0.1L, n);
+      const auto [a, b] = integ.applications(f, n);
+      EXPECT_EQ(a + b, f.applications);
+      EXPECT_GT(b, 0);
+    }
+  }
+}

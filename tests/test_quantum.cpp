@@ -578,3 +578,68 @@ TEST(QuantumImaginaryTime, ConvergenceCriterionAndTheRateOfApproach) {
   bad.converge = -1;
   EXPECT_THROW(solve(bad, "M8", dt, 10), std::invalid_argument);
 }
+
+// The approach, not only the limit: the first excited state of the 1D oscillator, found by imaginary time with
+// Gram-Schmidt against the ground state after every step, carries a component of the second excited state that
+// decays as e^{-(E_2 - E_1) tau} and one of the ground state, left by the ground state's own error, that decays
+// as e^{-(E_1 - E_0) tau}: both gaps are 1, so its energy error falls by e^{-2} per unit of tau (here the ground
+// state's part dominates). From tau = 2 to tau = 3: a ratio e^{-2} = 0.135, within 25% (measured 0.136).
+TEST(QuantumImaginaryTime, ExcitedStateApproachesAtTheRateOfItsGap) {
+  QuantumProblem<double> p;
+  p.grid = 64;
+  p.time = TimeKind::imaginary;
+  p.x0 = {0.7};
+  p.states = 2;
+  const double dt = 0.05;
+  const auto a = solve(p, "M6", dt, 40);
+  const auto b = solve(p, "M6", dt, 60);
+  ASSERT_EQ(a.energies.size(), 2u);
+  const double ea = a.energies[1] - 1.5, eb = b.energies[1] - 1.5;
+  std::printf("excited state: E_1 - 3/2 = %.4e at tau 2, %.4e at tau 3, ratio %.4f\n", ea, eb, eb / ea);
+  EXPECT_GT(std::abs(ea), 1e-4);  // far above the converged level
+  EXPECT_NEAR(eb / ea, std::exp(-2.0), 0.25 * std::exp(-2.0));
+}
+
+// With a nonlinearity g != 0 the gradient methods (Chin's 4A) do not apply: the refusal of a backward method in
+// imaginary time suggests the others only.
+TEST(QuantumImaginaryTime, GrossPitaevskiiRefusalSuggestsNoGradientMethod) {
+  auto p = double_well_imaginary();
+  p.g = 1;
+  try {
+    solve(p, "FR", 0.05, 10);
+    ADD_FAILURE() << "FR was not refused";
+  } catch (const nystrom::invalid_input& e) {
+    const std::string w = e.what();
+    EXPECT_EQ(w.find("4A"), std::string::npos) << w;
+    EXPECT_NE(w.find("M4..M16"), std::string::npos) << w;
+  }
+}
+
+// Every state costs the same steps: with two states the transforms are twice those of one, up to the few of the
+// second state's orthogonalisation and observation (none of them a step).
+TEST(QuantumImaginaryTime, EachExcitedStateCostsTheStepsOfTheGroundState) {
+  QuantumProblem<double> p;
+  p.grid = 64;
+  p.time = TimeKind::imaginary;
+  p.x0 = {0.7};
+  const auto one = solve(p, "M6", 0.05, 40);
+  p.states = 2;
+  const auto two = solve(p, "M6", 0.05, 40);
+  std::printf("FFTs: one state %ld, two states %ld\n", static_cast<long>(one.fft_count),
+              static_cast<long>(two.fft_count));
+  EXPECT_NEAR(static_cast<double>(two.fft_count - one.fft_count), static_cast<double>(one.fft_count),
+              0.05 * static_cast<double>(one.fft_count));
+}
+
+// A heartbeat without its cadence is refused, as with a cadence of 0: no default cadence is chosen silently.
+TEST(QuantumSolve, AHeartbeatNeedsItsCadence) {
+  QuantumProblem<double> p;
+  p.grid = 16;
+  p.heartbeat = [](long, long) {};
+  EXPECT_THROW(solve(p, "Y4", 0.05, 4), std::invalid_argument);
+  p.heartbeat_steps = 2;
+  long beats = 0;
+  p.heartbeat = [&](long, long) { ++beats; };
+  solve(p, "Y4", 0.05, 4);
+  EXPECT_EQ(beats, 2);
+}

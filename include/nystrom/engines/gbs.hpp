@@ -190,7 +190,11 @@ class GbsIntegrator {
       const real_type rem = span - t;
       const bool final_step = H_ >= rem * real_type(0.999999);  // avoid a sliver of a last step
       const real_type H = final_step ? rem : H_;
-      if (!(H > abs(span) * real_type(1e-3) * epsilon_of<real_type>()) && !final_step)
+      // A step below the rounding level of t would not advance it (t + H == t): accepted steps of that size
+      // (a force that is NaN past a point the state reaches) would repeat until max_steps.
+      const real_type h_floor =
+          abs(span) * real_type(1e-3) > real_type(16) * t ? abs(span) * real_type(1e-3) : real_type(16) * t;
+      if (!(H > h_floor * epsilon_of<real_type>()) && !final_step)
         throw step_size_underflow("GBS: step size underflow at t = " + detail::fmt_g(as_double(t)) +
                                   " (singular force, or a tolerance the precision cannot reach)");
       real_type Hnew;

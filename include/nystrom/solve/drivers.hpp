@@ -347,7 +347,9 @@ struct StepEnds {
       terminal = true;
       return true;
     }
-    if (!taken && run.dir * as_double(t) >= run.dir * run.opt.checkpoint_at) {
+    // Not at the end of the span: the engine keeps no resume point there (as the fixed-step driver, which
+    // takes none in its last step).
+    if (!taken && t != run.prob.t1 && run.dir * as_double(t) >= run.dir * run.opt.checkpoint_at) {
       taken = true;
       want_checkpoint = true;
       return true;
