@@ -55,7 +55,7 @@ class Recorder {
     qp_ = q;
     vp_ = v;
     ap_ = q;
-    if (need_a_) accel(t, q, ap_);
+    if (need_a_) accel(t, q, v, ap_);
     if (opt_.dense) sol_.dense.push(t, q, v, ap_);
     gp_.clear();
     for (const auto& e : events_) gp_.push_back(e.g(t, q, v));
@@ -72,7 +72,7 @@ class Recorder {
     ++steps_;
     if (opt_.on_step && steps_ % opt_.on_step_every == 0) opt_.on_step(as_double(t));
     V& a = a_;
-    if (need_a_) accel(t, q, a);
+    if (need_a_) accel(t, q, v, a);
     // Events in this step, the earliest first.
     std::vector<std::pair<R, std::size_t>> hits;
     std::vector<R> g(events_.size());
@@ -113,7 +113,7 @@ class Recorder {
     }
     if (opt_.dense) {
       if (terminal)
-        sol_.dense.push(t_end, sol_.q_final, sol_.v_final, accel_copy(t_end, sol_.q_final));
+        sol_.dense.push(t_end, sol_.q_final, sol_.v_final, accel_copy(t_end, sol_.q_final, sol_.v_final));
       else
         sol_.dense.push(t, q, v, a);
     }
@@ -172,14 +172,14 @@ class Recorder {
     resize_like(x, y);
     assign(x, y);
   }
-  void accel(const R& t, const V& q, V& a) {
+  void accel(const R& t, const V& q, const V& v, V& a) {
     resize_like(a, q);
-    prob_.acceleration(t, q, a);
+    prob_.acceleration(t, q, v, a);
     ++sol_.output_force_evals;
   }
-  V accel_copy(const R& t, const V& q) {
+  V accel_copy(const R& t, const V& q, const V& v) {
     V a = q;
-    accel(t, q, a);
+    accel(t, q, v, a);
     return a;
   }
   void save(const R& t, const V& q, const V& v) {
