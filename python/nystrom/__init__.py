@@ -31,7 +31,8 @@ __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "solve_ivp", "Ode
 
 def methods():
     """The catalog: one dict per method with name, family, order, stages, forces_per_step, fsal,
-    symmetric, symplectic, complex, adaptive, published_digits, aliases, source, description."""
+    symmetric, symplectic, complex, adaptive, velocity (integrates velocity-dependent forces), published_digits,
+    aliases, source, description."""
     return _core.methods()
 
 
