@@ -205,14 +205,74 @@ MethodDef gbs_method_def() {
   d.info.name = "GBS";
   d.info.family = "extrapolation";
   d.info.adaptive = true;
+  d.info.velocity = true;
   d.info.source = "Gragg (1965); Bulirsch & Stoer (1966); Hairer, Norsett & Wanner I, sec. II.9/II.14 (ODEX2)";
   d.info.description = "Gragg-Bulirsch-Stoer extrapolation, adaptive step and order";
   d.build = []() -> MethodData { throw invalid_input("GBS has no coefficient table"); };
   return d;
 }
 
+MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string& name) {
+  try {
+    validate_mpe_sequence(k);
+  } catch (const std::invalid_argument& e) {
+    throw invalid_input(e.what());
+  }
+  MethodDef d;
+  d.info.name = name;
+  d.info.family = "mpe-midpoint";
+  d.info.order = 2 * static_cast<int>(k.size());
+  long evals = 1;
+  for (long x : k) evals += 2 * x - 1;
+  d.info.stages = static_cast<int>(evals);
+  d.info.forces_per_step = static_cast<int>(evals);
+  d.info.velocity = true;
+  d.info.source = "Gragg (1965); Hairer, Norsett & Wanner I, sec. II.9; Chin (2010) eq (14)";
+  d.info.description = "multi-product expansion over Gragg's modified midpoint rule (2k substeps), fixed step";
+  d.build = [k]() -> MethodData { return MpeDef{k, "GM", {}, false}; };
+  return d;
+}
+
+std::vector<std::string> velocity_methods() {
+  std::vector<std::string> out;
+  for (const auto& d : catalog())
+    if (d.info.velocity) out.push_back(d.info.name);
+  out.push_back(gbs_method_def().info.name);
+  out.push_back("mpe-midpoint:K1,K2,...");
+  return out;
+}
+
+namespace {
+std::string velocity_list() {
+  std::string list;
+  for (const auto& m : velocity_methods()) list += (list.empty() ? "" : ", ") + m;
+  return list;
+}
+}  // namespace
+
+std::string velocity_refusal(const std::string& name) {
+  return "method '" + name +
+         "' does not support velocity-dependent forces a(t, q, v); methods that do: " + velocity_list();
+}
+
+std::string first_order_refusal(const std::string& name) {
+  return "method '" + name +
+         "' does not integrate first-order systems y' = f(t, y); methods that do: " + velocity_list();
+}
+
 MethodDef resolve_solve_method(const std::string& spec) {
   if (spec == "GBS" || spec == "gbs") return gbs_method_def();
+  if (detail::lower(spec).rfind("mpe-midpoint:", 0) == 0) {
+    std::vector<long> k;
+    try {
+      k = parse_sequence(spec.substr(13));
+    } catch (const std::invalid_argument& e) {
+      throw invalid_input(e.what());
+    }
+    std::string name = "mpe-midpoint:";
+    for (std::size_t i = 0; i < k.size(); ++i) name += (i ? "," : "") + std::to_string(k[i]);
+    return midpoint_mpe_method_def(k, name);
+  }
   return resolve_method(spec);
 }
 

@@ -1,6 +1,7 @@
 // The definition of compiled::solve (solve/compiled.hpp), instantiated for one scalar type per file of lib/:
 // the inline path's drivers (solve/drivers.hpp) on std::vector<T> with the erased force, in its
-// time-independent and time-dependent forms.
+// time-independent, time-dependent and velocity-dependent forms (the last only with the methods for
+// y'' = f(t, y, y')).
 #pragma once
 
 #include <string>
@@ -18,6 +19,10 @@ Solution<std::vector<T>> solve(const ErasedProblem<T>& p, const MethodDef* def, 
   using V = std::vector<T>;
   const MethodDef resolved = def ? MethodDef{} : resolve_solve_method(spec);
   const MethodDef& method = def ? *def : resolved;
+  if (p.force.velocity_dependent()) {
+    const SecondOrderProblem<V, ErasedVelocity<T>> prob(ErasedVelocity<T>{p.force}, p.q0, p.v0, p.t0, p.t1);
+    return solve_detail::solve_impl(prob, method, options, events, resume);
+  }
   if (p.force.time_dependent()) {
     const SecondOrderProblem<V, ErasedTimed<T>> prob(ErasedTimed<T>{p.force}, p.q0, p.v0, p.t0, p.t1);
     return solve_detail::solve_impl(prob, method, options, events, resume);

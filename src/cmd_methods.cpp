@@ -25,6 +25,7 @@ nlohmann::json info_json(const nystrom::MethodInfo& m) {
           {"symplectic", m.symplectic},
           {"complex", m.complex},
           {"adaptive", m.adaptive},
+          {"velocity_dependent", m.velocity},
           {"published_digits", m.published_digits},
           {"aliases", m.aliases},
           {"source", m.source},
@@ -68,6 +69,7 @@ std::string markdown_row(const nystrom::MethodInfo& m) {
   if (m.symplectic) flags.push_back("sympl");
   if (m.complex) flags.push_back("cplx");
   if (m.adaptive) flags.push_back("adapt");
+  if (m.velocity) flags.push_back("vel");
   const std::string coefs = m.published_digits == 0 ? "exact" : fmt::format("{} digits", m.published_digits);
   return fmt::format("| `{}` | {} | {} | {} | {} | {} | {} | {} | {} |\n", m.name, cell(join(m.aliases, ", ")),
                      m.family, m.order, m.stages, m.forces_per_step, join(flags, " "), coefs, cell(m.source));
@@ -84,7 +86,8 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
       "wider working types where the order conditions allow it.\n\n"
       "Flags: `fsal` first force of a step reused from the last, `sym` symmetric (time-reversible), `sympl`\n"
       "symplectic, `cplx` complex coefficients (run on the complexified state, imaginary parts dropped after each\n"
-      "step), `adapt` adaptive step size from an embedded error estimate (run with a tolerance).\n\n"
+      "step), `adapt` adaptive step size from an embedded error estimate (run with a tolerance), `vel` integrates\n"
+      "velocity-dependent forces a(t, q, v).\n\n"
       "| name | aliases | family | order | stages | forces | flags | coefficients | source |\n"
       "| --- | --- | --- | ---: | ---: | ---: | --- | --- | --- |\n";
   for (const auto& d : cat) page += markdown_row(d.info);
@@ -101,7 +104,18 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
       "- `file:PATH`: a splitting method in a text file of drifts and kicks, written by `nystrom discover --write` or\n"
       "  by hand (format: include/nystrom/analysis/method_file.hpp); its declared order is verified on loading.\n\n"
       "The command-line tool also runs `GBS`, Gragg-Bulirsch-Stoer extrapolation with Hairer's order and step\n"
-      "control, given a tolerance (`nystrom run --method GBS --tol 1e-12`); it serves as the reference solution.\n";
+      "control, given a tolerance (`nystrom run --method GBS --tol 1e-12`); it serves as the reference solution.\n\n"
+      "## Velocity-dependent forces\n\n"
+      "A force a(t, q, v) (`force(q, v, a)` or `force(t, q, v, a)` in C++, `force(t, q, v)` in Python; `nystrom run\n"
+      "--problem arenstorf` or `damped-oscillator`) runs only with the methods for y'' = f(t, y, y'): " +
+      join(nystrom::velocity_methods(), ", ") +
+      ";\n`GBS` runs the first-order form z = (q, v) with Gragg's modified midpoint rule as its base, adaptive in "
+      "order\n"
+      "and step. `mpe-midpoint:K1,K2,...` is the multi-product expansion (Chin 2010, eq 14) over the same rule with\n"
+      "2k substeps, whose error expands in even powers of the step as a symmetric base's does: order 2n for n\n"
+      "products, fixed steps, 1 + sum(2k_i - 1) force evaluations per step. First-order systems y' = f(t, y) run\n"
+      "with the same methods. Every other method of the catalog is made for a(t, q) and is refused with one line\n"
+      "naming these.\n";
   page +=
       "\n## Planetary maps\n\n"
       "`nystrom run --problem outer-solar-system` also runs the Wisdom-Holman maps (docs/planetary.md): a stage is\n"
@@ -140,6 +154,8 @@ nystrom::cli::Registrar reg("methods", "List every method in the catalog", [](CL
                  m.forces_per_step, yn(m.fsal), yn(m.symmetric), yn(m.symplectic), yn(m.complex), m.source);
     }
     fmt::print("\nAlso: M<2n> (any even order), mpe:K1,K2,... (PV base), mpe-vv:K1,K2,..., adjoint:NAME.\n");
+    fmt::print("Velocity-dependent forces a(t, q, v) run with: {} (every other method is for a(t, q)).\n",
+               join(nystrom::velocity_methods(), ", "));
     fmt::print("\nPlanetary maps (run --problem outer-solar-system; also WH-NAME, WHD-NAME for catalog methods):\n");
     for (const auto& m : planetary_maps())
       fmt::print("{:<12} {:<12} {:>5} {:>6} {:>6}  {}\n", m.name, m.family, m.order, m.stages, m.forces_per_step,

@@ -12,6 +12,7 @@
 #include "runner.hpp"
 #include "runner_planetary.hpp"
 #include "runner_solve.hpp"
+#include "runner_velocity.hpp"
 #include "sweep.hpp"
 
 namespace {
@@ -76,7 +77,8 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   auto o = std::make_shared<Options>();
   app.add_option("--problem", o->req.problem,
                  "Problem: kepler (Chin eqs 35-36), harmonic, twobody (two equal masses), nbody (Plummer sphere), "
-                 "outer-solar-system (Hairer, GNI I.2.4; Wisdom-Holman maps WH, WH-M8, SABA3, ... or direct methods)")
+                 "outer-solar-system (Hairer, GNI I.2.4; Wisdom-Holman maps WH, WH-M8, SABA3, ... or direct methods); "
+                 "with velocity-dependent forces (GBS): arenstorf (Hairer-Norsett-Wanner I, II.0), damped-oscillator")
       ->capture_default_str();
   app.add_option("--n", o->req.n, "nbody: number of particles of the Plummer sphere")
       ->capture_default_str()
@@ -143,6 +145,17 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
       o->method = nystrom::cli::checkpoint_method(o->sreq.restart);
     }
     const auto def = nystrom::cli::resolve_run_method(o->method);
+    if (nystrom::cli::is_velocity_problem(o->req.problem)) {
+      if (o->sreq.any())
+        throw nystrom::cli::UsageError(
+            "--output-times, --events, --checkpoint and --restart run on the kepler problem");
+      const auto r = nystrom::cli::run_velocity_problem(o->req, def);
+      if (o->json)
+        std::cout << r.dump(2) << "\n";
+      else
+        nystrom::cli::print_velocity_report(r);
+      return 0;
+    }
     nystrom::cli::check_work_budget(nystrom::cli::run_work_units(o->req, def), "run");
     const bool adaptive = def.info.adaptive;  // GBS too: its h is then the mean accepted step
     if (o->sreq.any()) {

@@ -5,6 +5,8 @@
 //   auto sol  = nystrom::solve(prob, "M8", {.steps = 2000});                  // fixed step (or .h = 0.01)
 //   auto sol  = nystrom::solve(prob, "DP12-adaptive", {.rtol = 1e-12});       // adaptive (also M10-adaptive, ...)
 //   auto sol  = nystrom::solve(prob, "GBS", {.rtol = 1e-12});                 // Gragg-Bulirsch-Stoer
+//   force(q, v, a) or force(t, q, v, a): velocity-dependent forces (GBS; other methods are refused)
+//   nystrom::FirstOrderProblem(fun, y0, t0, t1): y' = f(t, y), fun(t, y, dy) (solve/first_order.hpp)
 //   sol.t, sol.q, sol.v         saved times and states (options.t_eval, or every step end)
 //   sol(t)                      the state at any t of the span (options.dense; solve/dense.hpp)
 //   sol.events                  located events (Event: g(t, q, v) = 0, direction, terminal)
@@ -23,9 +25,11 @@
 #include <vector>
 
 #include "nystrom/core/error.hpp"
+#include "nystrom/methods/catalog.hpp"
 #include "nystrom/solve/checkpoint.hpp"
 #include "nystrom/solve/compiled.hpp"
 #include "nystrom/solve/dense.hpp"
+#include "nystrom/solve/first_order.hpp"
 #include "nystrom/solve/options.hpp"
 #include "nystrom/solve/problem.hpp"
 #include "nystrom/solve/solution.hpp"
@@ -80,6 +84,26 @@ Solution<V> resume(const SecondOrderProblem<V, F>& problem, const std::string& m
   } else {
     return resume_inline(problem, method, from, options, events);  // std::array: #include <nystrom/solve_inline.hpp>
   }
+}
+
+/// Integrates a first-order system y' = f(t, y) (solve/first_order.hpp) with a method for velocity-dependent
+/// forces (GBS); any other method is refused with first_order_refusal's line (invalid_input).
+template <class V, class F>
+FirstOrderSolution<V> solve(const FirstOrderProblem<V, F>& problem, const MethodDef& method,
+                            const SolveOptions& options = {}, const std::vector<FirstOrderEvent<V>>& events = {}) {
+  if (!method.info.velocity) throw invalid_input(first_order_refusal(method.info.name));
+  const SecondOrderProblem<V, FirstOrderForce<V, F>> p(FirstOrderForce<V, F>{problem.fun},
+                                                       first_order_detail::zeros_like(problem.y0), problem.y0,
+                                                       problem.t0, problem.t1);
+  return first_order_detail::from_second_order(
+      solve(p, method, options, first_order_detail::second_order_events(events)));
+}
+
+/// The same with the method given by its specification.
+template <class V, class F>
+FirstOrderSolution<V> solve(const FirstOrderProblem<V, F>& problem, const std::string& method,
+                            const SolveOptions& options = {}, const std::vector<FirstOrderEvent<V>>& events = {}) {
+  return solve(problem, resolve_solve_method(method), options, events);
 }
 
 }  // namespace nystrom

@@ -1,4 +1,6 @@
-"""nystrom: high-order splitting, Runge-Kutta-Nyström and multi-product integrators for q'' = a(q).
+"""nystrom: high-order splitting, Runge-Kutta-Nyström and multi-product integrators for q'' = a(q); GBS
+extrapolation for velocity-dependent forces q'' = a(t, q, v) and first-order systems y' = f(t, y)
+(``solve_ivp``).
 
     import numpy as np, nystrom
     res = nystrom.solve(lambda t, q: -q / np.linalg.norm(q) ** 3, [1.9, 0.0], [0.0, 0.2294157338705618],
@@ -17,6 +19,7 @@ import numbers
 
 from . import _core
 from ._solve import DenseSolution, OdeResult, solve
+from ._first_order import FirstOrderResult, solve_ivp
 from ._flows import FlowResult, damped, flows, magnetic, rotating_frame
 from ._quantum import QuantumResult, quantum
 from ._diffusion import SmoluchowskiResult, ThermalResult, smoluchowski, thermal
@@ -26,15 +29,16 @@ from . import problems
 
 __version__ = _core.__version__  # the CMake project version, as `nystrom --version` prints it
 
-__all__ = ["methods", "method_info", "coeffs", "bch", "solve", "OdeResult", "DenseSolution", "quantum", "QuantumResult",
-           "smoluchowski", "SmoluchowskiResult", "thermal", "ThermalResult",
+__all__ = ["methods", "method_info", "coeffs", "bch", "solve", "solve_ivp", "OdeResult", "FirstOrderResult",
+           "DenseSolution", "quantum", "QuantumResult", "smoluchowski", "SmoluchowskiResult", "thermal", "ThermalResult",
            "flows", "rotating_frame", "magnetic", "damped", "FlowResult",
            "langevin", "LangevinResult", "problems", "ensemble", "plot"]
 
 
 def methods():
     """The catalog: one dict per method with name, family, order, stages, forces_per_step, fsal,
-    symmetric, symplectic, complex, adaptive, published_digits, aliases, source, description."""
+    symmetric, symplectic, complex, adaptive, velocity (integrates velocity-dependent forces), published_digits,
+    aliases, source, description."""
     return _core.methods()
 
 

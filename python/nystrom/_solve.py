@@ -5,6 +5,7 @@ the C++ driver; this module checks the arguments, passes them on and wraps the r
 """
 
 import hashlib
+import inspect
 import math
 import numbers
 import os
@@ -257,10 +258,23 @@ def _checkpoint_args(checkpoint, checkpoint_at, restart, t0, t1):
     return ck_at, ck_file, restart_file
 
 
+def _takes_velocity(force):
+    """Whether a force is written force(t, q, v): three positional parameters without defaults."""
+    try:
+        params = inspect.signature(force).parameters.values()
+    except (TypeError, ValueError):  # a builtin without a signature: force(t, q)
+        return False
+    if any(p.kind == p.VAR_POSITIONAL for p in params):
+        return False
+    required = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) and p.default is p.empty]
+    return len(required) == 3
+
+
 def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None, rtol=None, atol=None,
           t_eval=None, events=None, dense_output=False, precision="double", keep_complex=False,
           progress=False, max_steps=10_000_000, bits=None, checkpoint=None, checkpoint_at=None, restart=None):
-    """Integrate q'' = a(q) from (q0, v0) over t_span with a method of the catalog (the library's solve()).
+    """Integrate q'' = a(t, q) or a(t, q, v) from (q0, v0) over t_span with a method of the catalog (the
+    library's solve()).
 
     Parameters
     ----------
@@ -268,6 +282,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         ``force(t, q) -> array`` of exactly ``q``'s shape (called once per force evaluation with the time of
         the stage; exceptions propagate unchanged), or a built-in problem (runs entirely in C++ with the GIL
         released). The time is integrated as one more coordinate (velocity 1), exactly by every method.
+        ``force(t, q, v)`` (three parameters without defaults) is a velocity-dependent force: it runs with
+        the methods for y'' = f(t, y, y') only (``GBS``; the others are refused with ValueError).
     q0, v0 : array_like
         Initial positions and velocities (any shape, the same for both). Default for a built-in problem:
         its initial state.
@@ -337,8 +353,10 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     precision = _precision(precision, bits)
 
     # ---- the problem ---------------------------------------------------------------------------
+    velocity = False
     if isinstance(force, Problem):
         problem = force
+        velocity = bool(getattr(problem, "_velocity", False))
         params = problem._params()
         q0 = _state("q0", problem.q0 if q0 is None else q0, problem.shape)
         v0 = _state("v0", problem.v0 if v0 is None else v0, problem.shape)
@@ -352,6 +370,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         v0 = _state("v0", v0, q0.shape)
         shape = q0.shape
         params, kind, py_force = [], "", force
+        velocity = _takes_velocity(force)
 
         def to_flat(x):
             return np.ascontiguousarray(x, dtype=float).reshape(-1)
@@ -382,6 +401,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     # adaptive form.
     tolerance = rtol is not None or atol is not None
     info = _core.solve_method_info(method, tolerance)
+    if velocity and not info["velocity"]:
+        raise ValueError(_core.velocity_refusal(info["name"]))
     h_value, n_steps = 0.0, 0
     if fixed:
         if steps is not None:
@@ -434,7 +455,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
         d = _core.solve(kind, params, py_force, list(shape), to_flat(q0), to_flat(v0), t0, t1, method, precision,
                         h_value, n_steps, rtol, atol, None if t_eval is None else _t_eval(t_eval, t0, t1), evs,
                         bool(dense_output), bool(keep_complex), _NO_LIMIT if fixed else int(max_steps),
-                        None if bar is None else bar.update, ck_at, ck_problem, ck_file, restart_file)
+                        None if bar is None else bar.update, ck_at, ck_problem, ck_file, restart_file, velocity)
         if bar is not None:  # a terminal event ends the output at its time
             t_end = t1 if d["status"] == 0 else float(d["t"][-1]) if d["status"] == 1 else None
     finally:

@@ -66,6 +66,7 @@ py::dict info_dict(const MethodInfo& m) {
   d["symplectic"] = m.symplectic;
   d["complex"] = m.complex;
   d["adaptive"] = m.adaptive;
+  d["velocity"] = m.velocity;
   d["published_digits"] = m.published_digits;
   d["aliases"] = m.aliases;
   d["source"] = m.source;
@@ -305,7 +306,7 @@ PYBIND11_MODULE(_core, m) {
          const std::string& method, const std::string& precision, double h, long steps, double rtol, double atol,
          std::optional<std::vector<double>> t_eval, const py::list& events, bool dense, bool keep_complex,
          long max_steps, py::object progress, double checkpoint_at, std::string checkpoint_problem,
-         std::string checkpoint_file, std::string restart_file) {
+         std::string checkpoint_file, std::string restart_file, bool velocity) {
         SolveRequest r;
         r.method = released([&] { return solve_method(method, rtol > 0 || atol > 0); });
         r.q0 = flat(q0);
@@ -333,7 +334,7 @@ PYBIND11_MODULE(_core, m) {
         if (problem.empty()) {
           if (precision != "double")
             throw invalid_input("precision '" + precision + "' is available for built-in problems only");
-          return solve_python_force(std::move(force), std::move(shape), r);
+          return solve_python_force(std::move(force), std::move(shape), r, velocity);
         }
         if (precision == "double") return solve_builtin_double(problem, params, r);
         return solve_builtin_extended(problem, params, r, precision);
@@ -342,9 +343,13 @@ PYBIND11_MODULE(_core, m) {
       py::arg("t0"), py::arg("t1"), py::arg("method"), py::arg("precision"), py::arg("h"), py::arg("steps"),
       py::arg("rtol"), py::arg("atol"), py::arg("t_eval"), py::arg("events"), py::arg("dense"), py::arg("keep_complex"),
       py::arg("max_steps"), py::arg("progress"), py::arg("checkpoint_at"), py::arg("checkpoint_problem"),
-      py::arg("checkpoint_file"), py::arg("restart_file"),
+      py::arg("checkpoint_file"), py::arg("restart_file"), py::arg("velocity") = false,
       "solve() (nystrom/solve.hpp) on a built-in problem (problem: its name) or a Python force(t, q) "
-      "(problem: ''); nystrom.solve checks the arguments and wraps the result.");
+      "(problem: ''; velocity: force(t, q, v)); nystrom.solve checks the arguments and wraps the result.");
+  m.def("velocity_refusal", &velocity_refusal, py::arg("method"),
+        "The one-line refusal of a method for a velocity-dependent force (the text of the C++ solve()).");
+  m.def("first_order_refusal", &first_order_refusal, py::arg("method"),
+        "The one-line refusal of a method for a first-order system (the text of the C++ solve()).");
 
   register_flows(m);
   register_langevin(m);

@@ -365,8 +365,9 @@ struct SmallProblemForce {
 
 // ---- the entry points (one translation unit each, so that they compile in parallel) -----------------------
 
-/// A Python force(t, q) in double (real and complex coefficients).
-py::dict solve_python_force(py::object force, std::vector<py::ssize_t> shape, const SolveRequest& r);
+/// A Python force(t, q) in double (real and complex coefficients), or force(t, q, v) when `velocity`.
+py::dict solve_python_force(py::object force, std::vector<py::ssize_t> shape, const SolveRequest& r,
+                            bool velocity = false);
 /// A built-in problem in double: "kepler", "henon_heiles", "harmonic" (params: omega^2), "nbody" (params:
 /// eps^2, then G m_i; the structure-of-arrays layout of nbody.hpp).
 py::dict solve_builtin_double(const std::string& problem, const std::vector<double>& params, const SolveRequest& r);

@@ -1,4 +1,5 @@
-// solve() on a Python force(t, q) in double, for real and complex coefficients.
+// solve() on a Python force(t, q) in double, for real and complex coefficients, and on a velocity-dependent
+// force(t, q, v).
 //
 // The state carries the time as one more coordinate, the last (velocity 1, acceleration 0): every method
 // integrates it exactly (drifts move it by c h, RKN stages by c_i h, the multi-product combination has
@@ -39,19 +40,24 @@ struct PyForce {
     py::array_t<S> arr(shape);
     S* dst = arr.mutable_data();
     for (std::size_t i = 0; i < n; ++i) dst[i] = q[i];
-    py::object r = fn(to_double(q[n]), arr);
+    read<S>(fn(to_double(q[n]), arr), "force(t, q)", a);
+  }
+
+  /// The result r of the call `what` into a[0..n), a[n] = 0: exactly q's shape.
+  template <class S, class W>
+  void read(const py::object& r, const char* what, W& a) const {
     using Arr = py::array_t<S, py::array::c_style | py::array::forcecast>;
     if (!py::isinstance<py::array>(r) && !py::isinstance<py::sequence>(r))
-      throw py::type_error("force(t, q) must return an array of numbers, got " +
+      throw py::type_error(std::string(what) + " must return an array of numbers, got " +
                            std::string(py::str(py::type::of(r).attr("__name__"))));
     Arr res = Arr::ensure(r);
-    if (!res) throw py::type_error("force(t, q) must return an array of numbers");
+    if (!res) throw py::type_error(std::string(what) + " must return an array of numbers");
     // The exact shape of q: an array of the right size and another shape (q.T, a flattened q) is a
     // mistake that would mix the coordinates up.
     const bool same =
         static_cast<std::size_t>(res.ndim()) == shape.size() && std::equal(shape.begin(), shape.end(), res.shape());
     if (!same)
-      throw py::value_error("force(t, q) returned an array of shape " +
+      throw py::value_error(std::string(what) + " returned an array of shape " +
                             shape_text(res.shape(), static_cast<std::size_t>(res.ndim())) + " for q of shape " +
                             shape_text(shape.data(), shape.size()) + ": it must return q's shape");
     const S* src = res.data();
@@ -61,12 +67,31 @@ struct PyForce {
   }
 };
 
+/// force(t, q, v): the same with the velocity, and the time solve() gives a velocity-dependent force (exact
+/// at every stage; coordinate n of q and v, the time and its rate, are not passed).
+struct PyVelocityForce {
+  PyForce base;
+  void operator()(const double& t, const std::vector<double>& q, const std::vector<double>& v,
+                  std::vector<double>& a) const {
+    py::gil_scoped_acquire hold;
+    py::array_t<double> qa(base.shape), va(base.shape);
+    double* qd = qa.mutable_data();
+    double* vd = va.mutable_data();
+    for (std::size_t i = 0; i < base.n; ++i) {
+      qd[i] = q[i];
+      vd[i] = v[i];
+    }
+    base.read<double>(base.fn(t, qa, va), "force(t, q, v)", a);
+  }
+};
+
 }  // namespace
 
-py::dict solve_python_force(py::object force, std::vector<py::ssize_t> shape, const SolveRequest& r) {
+py::dict solve_python_force(py::object force, std::vector<py::ssize_t> shape, const SolveRequest& r, bool velocity) {
   SolveRequest req = r;
   req.options.engine.mpe_schedule = MpeSchedule::sequential;  // one thread calls the force
   const std::size_t n = r.q0.size();
+  if (velocity) return run_solve<std::vector<double>>(PyVelocityForce{{force, shape, n}}, req, true, true);
   return run_solve<std::vector<double>>(PyForce{force, std::move(shape), n}, req, true, true);
 }
 

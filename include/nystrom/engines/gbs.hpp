@@ -20,6 +20,13 @@
 // size is kept between calls, so many short calls (one per step of another method) are efficient.
 // As a "method", integrate(s, h, n) makes n such calls of length h.
 //
+// A velocity-dependent force q'' = f(q, v) (the force callable as force(q, v, a)) runs the first-order
+// form z = (q, v), z' = (v, f(q, v)) with Gragg's modified midpoint rule as the base method (HNW II.9,
+// ODEX; no smoothing step): with h = H / n (n even),
+//        z_1 = z_0 + h z'(z_0),  z_{k+1} = z_{k-1} + 2h z'(z_k)  (k = 1 .. n-1),  result z_n,
+// whose error also expands in powers of h^2 (Gragg 1965); extrapolation and control are the same. It costs
+// n - 1 forces per row besides the shared first one.
+//
 // A time-dependent force runs as an autonomous one with the time as one more coordinate (velocity 1,
 // acceleration 0; solve() does so). set_clock(i, end) names that coordinate: GBS then sets it exactly at
 // every substep (t + k H / n, and t + H at the end of a step) instead of summing and extrapolating it, so
@@ -83,6 +90,9 @@ class GbsIntegrator {
   using scalar_type = typename V::value_type;
   using real_type = real_t<scalar_type>;
   static_assert(!is_complex_v<scalar_type>, "GBS works on real states");
+  /// Whether the force takes the velocity (force(q, v, a)): the modified midpoint base.
+  static constexpr bool velocity_dependent =
+      std::is_invocable_v<F&, const V&, const V&, V&> && !std::is_invocable_v<F&, const V&, V&>;
 
   GbsIntegrator(F force, GbsOptions opt = {}) : force_(std::move(force)), opt_(opt) {
     if (opt_.max_columns < 3 || opt_.max_columns > 30)
@@ -109,9 +119,12 @@ class GbsIntegrator {
     k_ = std::clamp(static_cast<int>(-std::log10(tol) * 0.6 + 1.5), 3, km - 1);
     H_ = static_cast<real_type>(opt_.initial_step);
     A_.resize(static_cast<std::size_t>(km) + 1);
-    A_[1] = nseq_[0] + 1;
+    // Force evaluations of columns 1..j (the midpoint rule needs one less per row than Störmer's).
+    const long per_row = velocity_dependent ? -1 : 0;
+    A_[1] = nseq_[0] + 1 + per_row;
     for (int j = 2; j <= km; ++j)
-      A_[static_cast<std::size_t>(j)] = A_[static_cast<std::size_t>(j) - 1] + nseq_[static_cast<std::size_t>(j) - 1];
+      A_[static_cast<std::size_t>(j)] =
+          A_[static_cast<std::size_t>(j) - 1] + nseq_[static_cast<std::size_t>(j) - 1] + per_row;
     row_.resize(static_cast<std::size_t>(km));
     prev_.resize(static_cast<std::size_t>(km));
   }
@@ -235,6 +248,49 @@ class GbsIntegrator {
   void step(State<V>& s, real_type h) { integrate_to(s, h); }
 
  private:
+  // The force at (q, v), whichever form it has.
+  void eval(const V& q, const V& v, V& a) {
+    if constexpr (velocity_dependent) {
+      force_(q, v, a);
+    } else {
+      (void)v;
+      force_(q, a);
+    }
+    ++evals_;
+  }
+
+  // Gragg's modified midpoint rule on z = (q, v) with n substeps of H / n from s with f0 = f(q0, v0):
+  // z_n in out (velocity-dependent forces).
+  void midpoint(const State<V>& s, const V& f0, real_type H, long n, State<V>& out) {
+    const std::size_t dim = s.q.size();
+    const real_type h = H / real_type(n);
+    const real_type h2 = h + h;
+    resize_like(out.q, s.q);
+    resize_like(out.v, s.q);
+    resize_like(zp_.q, s.q);
+    resize_like(zp_.v, s.q);
+    resize_like(f_, s.q);
+    for (std::size_t i = 0; i < dim; ++i) {
+      zp_.q[i] = s.q[i];
+      zp_.v[i] = s.v[i];
+      out.q[i] = s.q[i] + h * s.v[i];
+      out.v[i] = s.v[i] + h * f0[i];
+    }
+    set_clock_at(s, H, 1, n, out);
+    for (long k = 1; k < n; ++k) {
+      eval(out.q, out.v, f_);
+      for (std::size_t i = 0; i < dim; ++i) {
+        const scalar_type q = zp_.q[i] + h2 * out.v[i];
+        const scalar_type v = zp_.v[i] + h2 * f_[i];
+        zp_.q[i] = out.q[i];
+        zp_.v[i] = out.v[i];
+        out.q[i] = q;
+        out.v[i] = v;
+      }
+      set_clock_at(s, H, k + 1, n, out);
+    }
+  }
+
   // Störmer/Gragg with n substeps of H / n from (q0, v0) with f0 = f(q0): result (q, v) in out.
   void stoermer(const State<V>& s, const V& f0, real_type H, long n, State<V>& out) {
     const std::size_t dim = s.q.size();
@@ -305,8 +361,7 @@ class GbsIntegrator {
   bool try_step(State<V>& s, real_type H, bool last_rejected, real_type& Hnew) {
     const int km = opt_.max_columns;
     resize_like(f0_, s.q);
-    force_(s.q, f0_);
-    ++evals_;
+    eval(s.q, s.v, f0_);
     std::vector<real_type> Hj(static_cast<std::size_t>(km) + 1, H),
         W(static_cast<std::size_t>(km) + 1, std::numeric_limits<real_type>::max());
     const int k = k_;
@@ -316,7 +371,10 @@ class GbsIntegrator {
       // Row j of the table: row_[0] = T_{j,1} (Störmer with n_j), row_[l] = T_{j,l+1}; prev_ is row j-1.
       std::swap(row_, prev_);
       if (row_.size() < static_cast<std::size_t>(km)) row_.resize(static_cast<std::size_t>(km));
-      stoermer(s, f0_, H, nseq_[J], row_[0]);
+      if constexpr (velocity_dependent)
+        midpoint(s, f0_, H, nseq_[J], row_[0]);
+      else
+        stoermer(s, f0_, H, nseq_[J], row_[0]);
       for (std::size_t l = 1; l <= J; ++l) {
         const real_type r = real_type(nseq_[J]) / real_type(nseq_[J - l]);
         const real_type c = real_type(1) / (r * r - real_type(1));
@@ -396,6 +454,7 @@ class GbsIntegrator {
   real_type H_ = 0;
   std::vector<State<V>> row_, prev_;
   V f0_{}, f_{}, delta_{};
+  State<V> zp_{};  // the midpoint rule's z_{k-1}
   long evals_ = 0, accepted_ = 0, rejected_ = 0;
   ResumePoint resume_;
   long clock_ = -1;  // the time coordinate (set_clock), -1: none

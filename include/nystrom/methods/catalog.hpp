@@ -43,7 +43,25 @@ MethodDef resolve_method(const std::string& spec);
 /// step and order, tolerances rtol and atol (family "extrapolation"; no coefficient table).
 MethodDef gbs_method_def();
 
-/// What solve() resolves: resolve_method(spec), and "GBS" (or "gbs") for the extrapolation integrator.
+/// The multi-product expansion over Gragg's modified midpoint rule with sequence k (engines/mpe_midpoint.hpp):
+/// fixed steps, order 2 k.size(), for velocity-dependent forces and first-order systems ("mpe-midpoint:1,2,3";
+/// family "mpe-midpoint"; resolved by resolve_solve_method only, since it runs through solve()).
+MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string& name);
+
+/// The names of the methods that integrate velocity-dependent forces a(t, q, v) (MethodInfo::velocity):
+/// those of the catalog and GBS.
+std::vector<std::string> velocity_methods();
+
+/// The one-line refusal of method `name` for a velocity-dependent force, naming the methods that accept
+/// one (the same text in C++, Python and the command-line tool).
+std::string velocity_refusal(const std::string& name);
+
+/// The one-line refusal of method `name` for a first-order system y' = f(t, y) (which runs with the same
+/// methods).
+std::string first_order_refusal(const std::string& name);
+
+/// What solve() resolves: resolve_method(spec), "GBS" (or "gbs") for the extrapolation integrator, and
+/// "mpe-midpoint:K1,K2,..." (midpoint_mpe_method_def).
 MethodDef resolve_solve_method(const std::string& spec);
 
 /// Reads the method file of a "file:PATH" specification. The method-file format, which verifies a file's

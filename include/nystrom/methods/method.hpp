@@ -27,6 +27,7 @@ struct MethodInfo {
   bool symplectic = false;
   bool complex = false;
   bool adaptive = false;     // embedded pair with step-size control
+  bool velocity = false;     // integrates velocity-dependent forces a(t, q, v) (y'' = f(t, y, y'))
   int published_digits = 0;  // 0: exact (rational or closed form); else digits of the published table
   std::string source;        // the publication the coefficients come from
   std::string description;

@@ -48,6 +48,7 @@
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/engines/integrator.hpp"
+#include "nystrom/engines/mpe_midpoint.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/counting_force.hpp"
 #include "nystrom/solve/checkpoint.hpp"
@@ -79,14 +80,17 @@ struct extended<std::vector<S, A>, true> {
 };
 
 /// The force on the engine's vector: the user's force, time-reversed for backward integration
-/// (dir = -1: t = -tau) and with t read from the extra coordinate when it is time-dependent.
+/// (dir = -1: t = -tau, and the user's velocity is -dq/dtau) and with t read from the extra coordinate when
+/// it is time-dependent. A velocity-dependent force is called as force(q, v, a) by the engine (GBS's
+/// midpoint base).
 template <class V, class VE, class F, bool TD>
 struct EngineForce {
+  static constexpr bool VD = VelocityForce<F, V>;
   F f;
   int dir = 1;
   std::size_t n = 0;
-  V qb{}, ab{};
-  void operator()(const VE& q, VE& a) {
+  V qb{}, ab{}, vb{};
+  void operator()(const VE& q, VE& a) requires(!VD) {
     if constexpr (!TD) {
       f(q, a);
     } else {
@@ -96,6 +100,30 @@ struct EngineForce {
       for (std::size_t i = 0; i < n; ++i) qb[i] = q[i];
       const R t = dir > 0 ? R(q[n]) : R(-q[n]);
       f(t, static_cast<const V&>(qb), ab);
+      for (std::size_t i = 0; i < n; ++i) a[i] = ab[i];
+      a[n] = typename VE::value_type(0);
+    }
+  }
+  void operator()(const VE& q, const VE& v, VE& a) requires(VD) {
+    using R = real_t<typename V::value_type>;
+    if constexpr (!TD) {
+      if (dir > 0) {
+        f(q, v, a);
+        return;
+      }
+      resize_like_n(vb, n);
+      for (std::size_t i = 0; i < n; ++i) vb[i] = -v[i];
+      f(q, static_cast<const V&>(vb), a);
+    } else {
+      resize_like_n(qb, n);
+      resize_like_n(vb, n);
+      resize_like_n(ab, n);
+      for (std::size_t i = 0; i < n; ++i) {
+        qb[i] = q[i];
+        vb[i] = dir > 0 ? v[i] : -v[i];
+      }
+      const R t = dir > 0 ? R(q[n]) : R(-q[n]);
+      f(t, static_cast<const V&>(qb), static_cast<const V&>(vb), ab);
       for (std::size_t i = 0; i < n; ++i) a[i] = ab[i];
       a[n] = typename VE::value_type(0);
     }
@@ -271,7 +299,7 @@ struct Run {
   Conversion<V, VE, td> conversion() const { return {dir, n}; }
   State<VE> to_engine(const R& t, const V& q, const V& v) const { return conversion().to_engine(t, q, v); }
   void from_engine(const State<VE>& s, V& q, V& v) const { conversion().from_engine(s, q, v); }
-  Force force() const { return {prob.force, dir, n, {}, {}}; }
+  Force force() const { return {prob.force, dir, n, {}, {}, {}}; }
   /// The dense output's partial step with `engine` (a copy the solution keeps).
   template <class Engine>
   typename DenseOutput<V>::PartialStep partial_step(Engine engine) const {
@@ -393,6 +421,22 @@ void drive_engine(const Run<V, F, VE>& run, Recorder<V, SecondOrderProblem<V, F>
   ends.finish(sol);
 }
 
+/// The engine of a fixed-step method: the catalog's Integrator, or for a velocity-dependent force the
+/// multi-product expansion over Gragg's midpoint rule (the one fixed-step family for such forces).
+template <class VE, class V, class F>
+auto make_fixed_engine(const Run<V, F, VE>& run, const MethodDef& def, const EngineOptions& eo) {
+  if constexpr (Run<V, F, VE>::Force::VD) {
+    using T = real_t<typename VE::value_type>;
+    const MethodData data = def.build();
+    const auto* m = std::get_if<MpeDef>(&data);
+    if (!m || def.info.family != "mpe-midpoint") throw invalid_input(velocity_refusal(def.info.name));
+    return MidpointMpeIntegrator<VE, typename Run<V, F, VE>::Force>(
+        m->k, mpe_coefficients_as<T>(mpe_coefficients(m->k)), run.force(), eo);
+  } else {
+    return make_integrator<VE>(def, run.force(), eo);
+  }
+}
+
 template <class VE, class V, class F>
 void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
                const std::vector<Event<V>>& events, Solution<V>& sol, int dir,
@@ -416,7 +460,8 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
     n = std::max(1L, static_cast<long>(nd));
   }
   if (n > opt.max_steps) throw too_many_steps("the span needs " + std::to_string(n) + " steps, more than max_steps");
-  auto integ = make_integrator<VE>(def, run.force(), opt.engine);
+  auto integ = make_fixed_engine<VE>(run, def, opt.engine);
+  using Engine = decltype(integ);
   const R tau0 = sgn_mul(dir, prob.t0), tau1 = sgn_mul(dir, prob.t1);
   State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
   long k0 = 0;
@@ -443,7 +488,7 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
   // A failed run reports the forces evaluated up to the failure.
   struct CountOnExit {
     Solution<V>& sol;
-    const Integrator<VE, typename Run<V, F, VE>::Force>& engine;
+    const Engine& engine;
     long evals0;
     ~CountOnExit() { sol.force_evals = evals0 + engine.force_evals(); }
   } count_on_exit{sol, integ, evals0};
@@ -637,6 +682,14 @@ void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& 
       });
 }
 
+/// Throws invalid_input unless the options give a tolerance (adaptive methods and GBS).
+inline void check_tolerances(const MethodDef& def, const SolveOptions& opt) {
+  if (!(opt.rtol >= 0) || !std::isfinite(opt.rtol)) throw invalid_input("rtol must be finite and >= 0");
+  if (!(opt.atol >= 0) || !std::isfinite(opt.atol)) throw invalid_input("atol must be finite and >= 0");
+  if (opt.rtol == 0 && opt.atol == 0)
+    throw invalid_input("method '" + def.info.name + "' needs a tolerance (rtol > 0 or atol > 0)");
+}
+
 /// The run of solve_impl with the method's engine, into sol.
 template <class V, class F, class VE>
 void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
@@ -644,11 +697,18 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
                 const Checkpoint<real_t<typename V::value_type>>* resume, bool gbs) {
   using R = real_t<typename V::value_type>;
   constexpr bool td = SecondOrderProblem<V, F>::time_dependent;
-  if (gbs || def.info.adaptive) {
-    if (!(opt.rtol >= 0) || !std::isfinite(opt.rtol)) throw invalid_input("rtol must be finite and >= 0");
-    if (!(opt.atol >= 0) || !std::isfinite(opt.atol)) throw invalid_input("atol must be finite and >= 0");
-    if (opt.rtol == 0 && opt.atol == 0)
-      throw invalid_input("method '" + def.info.name + "' needs a tolerance (rtol > 0 or atol > 0)");
+  if constexpr (SecondOrderProblem<V, F>::velocity_dependent) {
+    // Only the methods for y'' = f(t, y, y') are instantiated (solve_impl refused the others).
+    if (def.info.family == "mpe-midpoint") {
+      run_fixed<VE>(prob, def, opt, events, sol, dir, resume);
+      return;
+    }
+    if (!gbs) throw invalid_input(velocity_refusal(def.info.name));
+    check_tolerances(def, opt);
+    Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
+    run_gbs<VE>(run, sol, events, resume);
+  } else if (gbs || def.info.adaptive) {
+    check_tolerances(def, opt);
     Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
     if (gbs) {
       run_gbs<VE>(run, sol, events, resume);
@@ -689,6 +749,15 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
   using P = SecondOrderProblem<V, F>;
   constexpr bool td = P::time_dependent;
   problem.validate();
+  if constexpr (P::velocity_dependent) {
+    if (!def.info.velocity) throw invalid_input(velocity_refusal(def.info.name));
+  } else {
+    if (def.info.family == "mpe-midpoint")
+      throw invalid_input("method '" + def.info.name +
+                          "' is for velocity-dependent forces and first-order systems; for a(t, q) run its "
+                          "multi-product expansion over Verlet, mpe:" +
+                          def.info.name.substr(def.info.name.find(':') + 1));
+  }
   if (opt.max_steps <= 0) throw invalid_input("max_steps must be positive");
   P prob = problem;
   const int dir = prob.t1 >= prob.t0 ? 1 : -1;

@@ -2,8 +2,9 @@
 // in libnystrom, for every supported scalar type, instead of once per force in every program.
 //
 // ErasedForce<T> owns a copy of the user's callable (a lambda, capturing or not, or any functor) and calls
-// it through a function pointer: force(t, q, a) on std::vector<T> states, and force(q, a) on complex
-// states when the callable accepts them (complex-coefficient methods). Copies are deep, as copies of the
+// it through a function pointer: force(t, q, a) on std::vector<T> states, force(t, q, v, a) when the
+// force depends on the velocity, and force(q, a) on complex states when the callable accepts them
+// (complex-coefficient methods). Copies are deep, as copies of the
 // callable itself would be: an engine that gives each thread its own force (the concurrent multi-product
 // schedule) gets its own copy of the user's functor, exactly as on the inline path.
 //
@@ -38,8 +39,8 @@ class ErasedForce {
 
   ErasedForce() = default;
 
-  /// Wraps a copy of f, a force for states V in either form of SecondOrderProblem (force(q, a) or
-  /// force(t, q, a)); force(q, a) on complex states when f accepts them.
+  /// Wraps a copy of f, a force for states V in any form of SecondOrderProblem (force(q, a),
+  /// force(t, q, a), force(q, v, a) or force(t, q, v, a)); force(q, a) on complex states when f accepts them.
   template <class F>
   requires(!std::is_same_v<std::decay_t<F>, ErasedForce>) explicit ErasedForce(const F& f)
       : obj_(new F(f)), ops_(&ops_for<F>) {}
@@ -57,6 +58,8 @@ class ErasedForce {
 
   /// Whether the wrapped force takes the time (force(t, q, a)).
   bool time_dependent() const { return ops_ && ops_->time_dependent; }
+  /// Whether the wrapped force takes the velocity (force(q, v, a) or force(t, q, v, a)).
+  bool velocity_dependent() const { return ops_ && ops_->velocity != nullptr; }
   /// Whether it accepts complex states (complex-coefficient methods).
   bool accepts_complex() const { return ops_ && ops_->complex != nullptr; }
 
@@ -64,6 +67,12 @@ class ErasedForce {
   void operator()(const T& t, const V& q, V& a) {
     const std::size_t n = a.size();
     ops_->real(obj_, t, q, a);
+    if (a.size() != n) erased_detail::resized(a.size(), n);
+  }
+  /// a = a(t, q, v) of a velocity-dependent force.
+  void operator()(const T& t, const V& q, const V& v, V& a) {
+    const std::size_t n = a.size();
+    ops_->velocity(obj_, t, q, v, a);
     if (a.size() != n) erased_detail::resized(a.size(), n);
   }
   /// a = a(q) on complex states; invalid_input when the force does not accept them.
@@ -80,21 +89,41 @@ class ErasedForce {
  private:
   struct Ops {
     void (*real)(void*, const T&, const V&, V&);
+    void (*velocity)(void*, const T&, const V&, const V&, V&);
     void (*complex)(void*, const VC&, VC&);
     void* (*clone)(const void*);
     void (*destroy)(void*);
     bool time_dependent;
   };
   template <class F>
-  static constexpr Ops ops_for = {[](void* p, const T& t, const V& q, V& a) {
-                                    F& f = *static_cast<F*>(p);
-                                    if constexpr (AutonomousForce<F, V>) {
-                                      (void)t;
-                                      f(q, a);
-                                    } else {
-                                      f(t, q, a);
-                                    }
-                                  },
+  static constexpr Ops ops_for = {[] {
+                                    if constexpr (VelocityForce<F, V>)
+                                      return static_cast<void (*)(void*, const T&, const V&, V&)>(nullptr);
+                                    else
+                                      return +[](void* p, const T& t, const V& q, V& a) {
+                                        F& f = *static_cast<F*>(p);
+                                        if constexpr (AutonomousForce<F, V>) {
+                                          (void)t;
+                                          f(q, a);
+                                        } else {
+                                          f(t, q, a);
+                                        }
+                                      };
+                                  }(),
+                                  [] {
+                                    if constexpr (VelocityForce<F, V>)
+                                      return +[](void* p, const T& t, const V& q, const V& v, V& a) {
+                                        F& f = *static_cast<F*>(p);
+                                        if constexpr (AutonomousVelocityForce<F, V>) {
+                                          (void)t;
+                                          f(q, v, a);
+                                        } else {
+                                          f(t, q, v, a);
+                                        }
+                                      };
+                                    else
+                                      return static_cast<void (*)(void*, const T&, const V&, const V&, V&)>(nullptr);
+                                  }(),
                                   [] {
                                     if constexpr (AutonomousForce<F, V> && std::is_invocable_v<F&, const VC&, VC&>)
                                       return +[](void* p, const VC& q, VC& a) { (*static_cast<F*>(p))(q, a); };
@@ -102,13 +131,14 @@ class ErasedForce {
                                       return static_cast<void (*)(void*, const VC&, VC&)>(nullptr);
                                   }(),
                                   [](const void* p) -> void* { return new F(*static_cast<const F*>(p)); },
-                                  [](void* p) { delete static_cast<F*>(p); }, !AutonomousForce<F, V>};
+                                  [](void* p) { delete static_cast<F*>(p); },
+                                  !AutonomousForce<F, V>};
 
   void* obj_ = nullptr;
   const Ops* ops_ = nullptr;
 };
 
-/// The two forms the compiled drivers are instantiated for: a time-independent force (with its complex
+/// The forms the compiled drivers are instantiated for: a time-independent force (with its complex
 /// form), and a time-dependent one.
 template <class T>
 struct ErasedAutonomous {
@@ -120,6 +150,12 @@ template <class T>
 struct ErasedTimed {
   ErasedForce<T> f;
   void operator()(const T& t, const std::vector<T>& q, std::vector<T>& a) { f(t, q, a); }
+};
+/// A velocity-dependent force (always given the time: one instantiation for both of its forms).
+template <class T>
+struct ErasedVelocity {
+  ErasedForce<T> f;
+  void operator()(const T& t, const std::vector<T>& q, const std::vector<T>& v, std::vector<T>& a) { f(t, q, v, a); }
 };
 
 /// A problem on std::vector<T> states with its force erased: what the compiled solve() receives.

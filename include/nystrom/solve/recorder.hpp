@@ -62,7 +62,7 @@ class Recorder {
     vp_ = v;
     ap_ = q;
     ap_valid_ = false;
-    if (need_a_) accel(t, q, ap_), ap_valid_ = true;
+    if (need_a_) accel(t, q, v, ap_), ap_valid_ = true;
     if (opt_.dense) sol_.dense.push(t, q, v, ap_);
     gp_.clear();
     for (const auto& e : events_) gp_.push_back(e.g(t, q, v));
@@ -80,7 +80,7 @@ class Recorder {
     if (opt_.on_step && steps_ % opt_.on_step_every == 0) opt_.on_step(as_double(t));
     V& a = a_;
     a_valid_ = false;
-    if (need_a_) accel(t, q, a), a_valid_ = true;
+    if (need_a_) accel(t, q, v, a), a_valid_ = true;
     // Events in this step, the earliest first.
     struct Hit {
       R t;
@@ -129,7 +129,7 @@ class Recorder {
     }
     if (opt_.dense) {
       if (terminal)
-        sol_.dense.push(t_end, sol_.q_final, sol_.v_final, accel_copy(t_end, sol_.q_final));
+        sol_.dense.push(t_end, sol_.q_final, sol_.v_final, accel_copy(t_end, sol_.q_final, sol_.v_final));
       else
         sol_.dense.push(t, q, v, a);
     }
@@ -190,14 +190,14 @@ class Recorder {
     resize_like(x, y);
     assign(x, y);
   }
-  void accel(const R& t, const V& q, V& a) {
+  void accel(const R& t, const V& q, const V& v, V& a) {
     resize_like(a, q);
-    prob_.acceleration(t, q, a);
+    prob_.acceleration(t, q, v, a);
     ++sol_.output_force_evals;
   }
-  V accel_copy(const R& t, const V& q) {
+  V accel_copy(const R& t, const V& q, const V& v) {
     V a = q;
-    accel(t, q, a);
+    accel(t, q, v, a);
     return a;
   }
   void save(const R& t, const V& q, const V& v) {
@@ -228,8 +228,8 @@ class Recorder {
       s.v = v;
       return t;
     }
-    if (!ap_valid_) accel(tp_, qp_, ap_), ap_valid_ = true;
-    if (!a_valid_) accel(t, q, a_), a_valid_ = true;
+    if (!ap_valid_) accel(tp_, qp_, vp_, ap_), ap_valid_ = true;
+    if (!a_valid_) accel(t, q, v, a_), a_valid_ = true;
     const auto& g = events_[i].g;
     // The zero of g on the quintic Hermite interpolant between the knots (ta, qa, va, aa) and
     // (tb, qb, vb, ab), inside the bracket (lo, hi) where g has the signs glo, ghi, from `first`.
@@ -258,7 +258,7 @@ class Recorder {
         return te;
       }
       resize_like(ax, x.q);
-      accel(te, x.q, ax);
+      accel(te, x.q, x.v, ax);
       // The knot te and the step end on the other side of the zero.
       const bool below = (gx < R(0)) == (ga < R(0));  // the zero lies between te and t
       const R next = below ? on_interpolant(te, x.q, x.v, ax, t, q, v, a_, te, t, gx, gb, te)
