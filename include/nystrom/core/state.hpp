@@ -138,28 +138,6 @@ inline void compensated_add(S& x, S& c, const S& d) {
   x = t;
 }
 
-/// Knuth's two-sum: s + e == a + b exactly (s the rounded sum), whatever the sizes of a and b.
-template <class S>
-NYSTROM_ALWAYS_INLINE inline S two_sum(const S& a, const S& b, S& e) {
-  const S s = a + b;
-  const S bp = s - a;
-  e = (a - (s - bp)) + (b - bp);
-  return s;
-}
-
-/// x + c += hi + lo, where lo already holds the carry c (x the value, c its carry; hi the leading part of an
-/// increment, lo its small rest with the carry, e.g. the force terms of a position update next to h v): the
-/// increment hi + lo is formed by an exact two-sum, and so is its addition to x; the new carry is the sum of both
-/// rounding errors, the only rounding (at the size of the carry). Unlike compensated_add, no part of the
-/// increment is lost to a rounding at its own size, and the new x is two additions after lo.
-template <class S>
-NYSTROM_ALWAYS_INLINE inline void compensated_add_folded(S& x, S& c, const S& hi, const S& lo) {
-  S ed, ex;
-  const S d = two_sum(hi, lo, ed);
-  x = two_sum(x, d, ex);
-  c = ed + ex;
-}
-
 /// The rounding errors of q and v carried between compensated updates. The carry survives from one
 /// integrate() call to the next only if the caller did not move the state in between.
 template <class V>
