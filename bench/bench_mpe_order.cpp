@@ -19,6 +19,7 @@
 #include "nystrom/engines/adaptive_mpe.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
+#include "nystrom/problems/reference.hpp"
 
 using namespace nystrom;
 
@@ -34,7 +35,6 @@ const std::vector<double> kTargets = {1e-6, 1e-9, 1e-12, 1e-13};
 void sweep(double ecc) {
   const KeplerProblem<double> prob(ecc);
   const double t_end = KeplerProblem<double>::period() * kPeriods;
-  const auto ex = KeplerProblem<long double>(static_cast<long double>(ecc)).exact(static_cast<long double>(t_end));
   std::vector<std::vector<double>> best(kMethods.size(), std::vector<double>(kTargets.size(), INFINITY));
   for (int it = 0; it < 40; ++it) {
     const double tol = std::pow(10.0, -5.0 - 0.25 * it);
@@ -50,8 +50,8 @@ void sweep(double ecc) {
         ai.integrate_to(s, 0.0, t_end);
         const auto t1 = std::chrono::steady_clock::now();
         seconds = std::min(seconds, std::chrono::duration<double>(t1 - t0).count());
-        err = static_cast<double>(
-            std::hypot(static_cast<long double>(s.q[0]) - ex.q[0], static_cast<long double>(s.q[1]) - ex.q[1]));
+        // against the exact orbit of the double start at t_end (problems/reference.hpp)
+        err = kepler_reference_errors(prob.initial_state(), s, t_end).position;
       }
       for (std::size_t k = 0; k < kTargets.size(); ++k)
         if (err <= kTargets[k]) best[m][k] = std::min(best[m][k], seconds);

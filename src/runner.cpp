@@ -56,19 +56,25 @@ template <class T>
 RunReport run_in_precision(const RunRequest& req, const MethodDef& def, bool gbs);
 
 nlohmann::json RunReport::to_json() const {
-  return {{"method", method},
-          {"family", family},
-          {"order", order},
-          {"problem", problem},
-          {"precision", precision},
-          {"ecc", num(ecc)},
-          {"steps", steps},
-          {"force_evals", force_evals},
-          {"h", num(h)},
-          {"precession_per_period", num(precession_per_period)},
-          {"energy_error", num(energy_error)},
-          {"position_error", num(position_error)},
-          {"seconds", num(seconds)}};
+  nlohmann::json j{{"method", method},
+                   {"family", family},
+                   {"order", order},
+                   {"problem", problem},
+                   {"precision", precision},
+                   {"ecc", num(ecc)},
+                   {"steps", steps},
+                   {"force_evals", force_evals},
+                   {"h", num(h)},
+                   {"precession_per_period", num(precession_per_period)},
+                   {"energy_error", num(energy_error)},
+                   {"position_error", num(position_error)},
+                   {"seconds", num(seconds)}};
+  if (!q.empty()) {  // the final state, each number to 17 significant digits (it reads back to the same double)
+    j["t"] = num(t);
+    j["q"] = q;
+    j["v"] = v;
+  }
+  return j;
 }
 
 const std::vector<std::string>& problem_names() {

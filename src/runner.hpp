@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -88,6 +89,9 @@ struct RunReport {
   double energy_error = nan;           // relative energy error at the end
   double position_error = nan;         // |q - q_exact| at the end
   double seconds = nan;
+  // kepler, harmonic: the end time and the final state (nearest doubles; JSON with 17 significant digits)
+  double t = nan;
+  std::vector<double> q, v;
 
   nlohmann::json to_json() const;
 };

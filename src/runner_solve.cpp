@@ -10,6 +10,7 @@
 
 #include "cli.hpp"
 #include "nystrom/problems/kepler.hpp"
+#include "nystrom/problems/reference.hpp"
 #include "nystrom/solve/solve.hpp"
 #include "runner_solve.hpp"
 
@@ -165,10 +166,12 @@ SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq,
   r.seconds = std::chrono::duration<double>(w1 - w0).count();
   State<V2> s{sol.q_final, sol.v_final};
   r.precession_per_period = signed_angle(lrl_vector(s0), lrl_vector(s)) / static_cast<double>(req.periods);
-  const double e0 = kepler_energy(s0);
-  r.energy_error = std::abs((kepler_energy(s) - e0) / e0);
-  const auto ex = kp.exact(t_end);
-  r.position_error = std::hypot(s.q[0] - ex.q[0], s.q[1] - ex.q[1]);
+  // against the exact orbit of s0 at the exact end time (problems/reference.hpp): n steps of t_end / n, or
+  // an adaptive run that lands on t_end
+  const long n = tolerance ? 1 : opt.steps;
+  const ReferenceErrors err = kepler_reference_errors(s0, s, t_end / static_cast<double>(n), n);
+  r.energy_error = err.energy;
+  r.position_error = err.position;
   // The final state exactly (the shortest decimal that reads back to the same double: a comparison of
   // two runs' q and v is a bitwise one).
   extra["t"] = sol.t_final;

@@ -15,6 +15,7 @@
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/kepler.hpp"
+#include "nystrom/problems/reference.hpp"
 #include "runner.hpp"
 
 namespace nystrom::cli {
@@ -54,12 +55,14 @@ RunReport run_harmonic(const RunRequest& req, const MethodDef& def) {
   HarmonicProblem<T> prob;
   RunReport r;
   const auto s = run_metered<T, HarmonicForce>(def, req, prob, r);
-  using std::abs;
   const T h = HarmonicProblem<T>::period() / T(req.steps_per_period);
-  const auto ex = prob.exact(h * T(r.steps));
-  r.position_error = as_double(abs(s.q[0] - ex.q[0]));
-  const T e = (s.q[0] * s.q[0] + s.v[0] * s.v[0]) / T(2);
-  r.energy_error = as_double(abs(e - T(1) / T(2)) / (T(1) / T(2)));
+  // against cos t, -sin t at the exact end time h n, in quad-double or better (problems/reference.hpp)
+  const ReferenceErrors err = harmonic_reference_errors(prob.initial_state(), s, h, r.steps);
+  r.position_error = err.position;
+  r.energy_error = err.energy;
+  r.t = as_double(h * T(r.steps));
+  r.q = {as_double(s.q[0])};
+  r.v = {as_double(s.v[0])};
   return r;
 }
 
@@ -71,7 +74,7 @@ KeplerRunResult run_kepler_metered(const MethodDef& def, const RunRequest& req) 
   KeplerRunResult r;
   const auto s = run_metered<T, KeplerForce>(def, req, prob, r);
   const T h = KeplerProblem<T>::period() / T(req.steps_per_period);
-  nystrom::detail::kepler_diagnostics(r, prob, prob.initial_state(), s, h * T(r.steps), req.periods);
+  nystrom::detail::kepler_diagnostics(r, prob.initial_state(), s, h, r.steps, req.periods);
   return r;
 }
 
@@ -96,6 +99,9 @@ RunReport run_in_precision(const RunRequest& req, const MethodDef& def, bool gbs
     out.energy_error = k.energy_error;
     out.position_error = k.position_error;
     out.seconds = k.seconds;
+    out.t = k.t;
+    out.q.assign(k.q.begin(), k.q.end());
+    out.v.assign(k.v.begin(), k.v.end());
     return out;
   }
   if (req.problem == "harmonic") {

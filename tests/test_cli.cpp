@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -20,6 +21,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "nystrom/problems/kepler.hpp"
+#include "nystrom/problems/reference.hpp"
 
 namespace {
 
@@ -86,6 +89,54 @@ TEST(Cli, RunJsonHasTheContractFields) {
   EXPECT_LT(std::abs(j["precession_per_period"].get<double>()), 1e-9);
   EXPECT_LT(j["position_error"].get<double>(), 1e-6);
   EXPECT_LT(j["energy_error"].get<double>(), 1e-7);
+}
+
+// Every run reports its end time and final state (each number reads back to the same double), and the errors it
+// reports are those of that state against the exact orbit of the initial state as rounded to the working
+// precision (problems/reference.hpp), recomputed here from the JSON alone.
+TEST(Cli, RunJsonReportsTheFinalStateItsErrorsMeasure) {
+  using V2 = std::array<double, 2>;
+  const auto s0 = nystrom::KeplerProblem<double>(0.9).initial_state();
+  const double h = nystrom::KeplerProblem<double>::period() / 1000;
+  for (const std::string precision : {"double", "long-double", "dd"}) {
+    for (const std::string method : {"M8 --steps-per-period 1000", "DP12-adaptive --tol 1e-10"}) {
+      const auto r = run("run --problem kepler --ecc 0.9 --periods 10 --method " + method + " --precision " +
+                         precision + " --json");
+      ASSERT_EQ(r.code, 0) << r.err;
+      const auto j = nlohmann::json::parse(r.out);
+      for (const char* key : {"t", "q", "v"}) ASSERT_TRUE(j.contains(key)) << key << " " << method << " " << precision;
+      const bool adaptive = j["adaptive"].get<bool>();
+      const nystrom::State<V2> s{{j["q"][0].get<double>(), j["q"][1].get<double>()},
+                                 {j["v"][0].get<double>(), j["v"][1].get<double>()}};
+      const double t_end = nystrom::KeplerProblem<double>::period() * 10;
+      // in double bitwise; a wider precision's end time is its own, rounded to double
+      if (precision == "double")
+        EXPECT_EQ(j["t"].get<double>(), adaptive ? t_end : h * 10000) << method;
+      else
+        EXPECT_NEAR(j["t"].get<double>(), t_end, 1e-13) << method << " " << precision;
+      const auto err =
+          adaptive ? nystrom::kepler_reference_errors(s0, s, t_end) : nystrom::kepler_reference_errors(s0, s, h, 10000);
+      const double reported = j["position_error"].get<double>();
+      if (precision == "double") {
+        // the same double state: the same error
+        EXPECT_NEAR(err.position, reported, 1e-6 * reported) << method;
+        EXPECT_NEAR(err.energy, j["energy_error"].get<double>(), 1e-6 * j["energy_error"].get<double>()) << method;
+      } else {
+        // q rounded to double from a wider state whose start is the double start here up to its own rounding
+        EXPECT_NEAR(err.position, reported, 1e-15 + 1e-3 * reported) << method << " " << precision;
+      }
+    }
+  }
+  // the harmonic oscillator too
+  const auto r = run("run --problem harmonic --method M8 --steps-per-period 100 --periods 3 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["q"].size(), 1u);
+  const double hh = 2 * std::acos(-1.0) / 100;
+  const auto err = nystrom::harmonic_reference_errors(
+      nystrom::State<std::array<double, 1>>{{1.0}, {0.0}},
+      nystrom::State<std::array<double, 1>>{{j["q"][0].get<double>()}, {j["v"][0].get<double>()}}, hh, 300);
+  EXPECT_NEAR(err.position, j["position_error"].get<double>(), 1e-6 * err.position);
 }
 
 TEST(Cli, RunReproducesChinFig1ErrorCoefficientsAtE09) {

@@ -2,7 +2,7 @@
 // integrate `steps` steps of size h with a catalog method (real or complex coefficients), or with GBS at a
 // tolerance (method "GBS"), and report the relative energy error and the position error against a GBS
 // reference run of the same length (tolerance ref_tol). For twobody the position error is also measured
-// against the analytic Kepler solution (relative coordinates).
+// against the exact orbit of the initial relative state (problems/reference.hpp).
 #pragma once
 
 #include <chrono>
@@ -12,6 +12,7 @@
 #include "localerr.hpp"
 #include "nystrom/engines/gbs.hpp"
 #include "nystrom/problems/kepler.hpp"
+#include "nystrom/problems/reference.hpp"
 
 namespace nystrom {
 
@@ -56,9 +57,12 @@ inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& set
   const double e0 = nbody_energy(inst.force, inst.particles.s);
   r.energy_error = std::abs((nbody_energy(inst.force, s) - e0) / e0);
   if (setup.problem == "twobody") {
-    const auto ex = KeplerProblem<double>(setup.ecc).exact(h * static_cast<double>(steps));
-    r.position_error = std::max(std::abs(s.q[1] - s.q[0] - ex.q[0]), std::abs(s.q[3] - s.q[2] - ex.q[1]));
-    r.reference = "analytic Kepler solution";
+    // the relative orbit (x_1 - x_0, y_1 - y_0) against the exact orbit of its initial state at time h steps
+    const auto rel = [](const State<std::vector<double>>& x) {
+      return State<std::array<double, 2>>{{x.q[1] - x.q[0], x.q[3] - x.q[2]}, {x.v[1] - x.v[0], x.v[3] - x.v[2]}};
+    };
+    r.position_error = kepler_reference_errors(rel(inst.particles.s), rel(s), h, steps).position;
+    r.reference = "exact Kepler orbit of the initial state";
   } else {
     GbsOptions o;
     o.rtol = o.atol = ref_tol;

@@ -1,7 +1,8 @@
 // Work-precision comparison of nystrom against Boost.Odeint on the planar Kepler problem.
 //
 // Every run integrates KeplerProblem (e = 0.5, 0.9; q0 at apocentre) over `periods` orbits and
-// measures the final position error |q - q_exact| against the analytic solution, the number of force
+// measures the final position error |q - q_exact| against the exact orbit of the start as rounded
+// to double, evaluated in quad-double at the time reached (problems/reference.hpp), the number of force
 // evaluations (counted by one functor shared by both libraries, CountingKepler) and the wall time of
 // the integration alone (steppers are built outside the clock; the minimum over repetitions is kept).
 //
@@ -37,6 +38,7 @@
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
+#include "nystrom/problems/reference.hpp"
 
 namespace nystrom::peers {
 
@@ -90,9 +92,14 @@ struct Outcome {
   bool budget = false;                                     // stopped by the force-evaluation cap
 };
 
+/// The time a run reached: n steps of h (fixed steps, h n exactly), or the end of the span (h = t_end, n = 1).
+struct EndTime {
+  double h = 0;
+  long n = 1;
+};
 /// One run: integrate from the start, fill the final state, the steps taken and the time reached.
 /// It may be called repeatedly (each call starts afresh from copies of prepared steppers).
-using Run = std::function<void(State<Vec2>& s, long& steps, double& t_end)>;
+using Run = std::function<void(State<Vec2>& s, long& steps, EndTime& end)>;
 /// Prepares a run at one parameter (steps per period, or tolerance) outside the clock.
 using Prepare = std::function<Run(double param)>;
 
@@ -150,12 +157,12 @@ namespace detail {
 
 inline State<Vec2> start(double ecc) { return KeplerProblem<double>(ecc).initial_state(); }
 
-inline double position_error(double ecc, const State<Vec2>& s, double t_end) {
-  // The analytic solution in long double, at the time the integrator actually reached.
-  const KeplerProblem<long double> prob(static_cast<long double>(ecc));
-  const auto ex = prob.exact(static_cast<long double>(t_end));
-  const long double dx = s.q[0] - ex.q[0], dy = s.q[1] - ex.q[1];
-  const double err = static_cast<double>(std::sqrt(dx * dx + dy * dy));
+inline double position_error(double ecc, const State<Vec2>& s, const EndTime& end) {
+  // The exact orbit of the start as rounded to double, in quad-double, at the time the integrator
+  // actually reached (problems/reference.hpp).
+  if (!std::isfinite(s.q[0]) || !std::isfinite(s.q[1]) || !std::isfinite(s.v[0]) || !std::isfinite(s.v[1]))
+    return std::numeric_limits<double>::infinity();
+  const double err = kepler_reference_errors(start(ecc), s, end.h, end.n).position;
   return std::isfinite(err) ? err : std::numeric_limits<double>::infinity();
 }
 
@@ -183,12 +190,12 @@ inline MethodSpec nystrom_fixed(const std::string& name, double ecc, long period
     return [proto, ecc, periods](double spp) -> Run {
       const long n = static_cast<long>(spp) * periods;
       const double h = period() / static_cast<double>(static_cast<long>(spp));
-      return [proto, ecc, n, h](State<Vec2>& s, long& steps, double& t_end) {
+      return [proto, ecc, n, h](State<Vec2>& s, long& steps, EndTime& end) {
         auto integ = *proto;  // a fresh copy: no force cache from an earlier repetition
         s = start(ecc);
         integ.integrate(s, h, n);
         steps = n;
-        t_end = h * static_cast<double>(n);
+        end = {h, n};
       };
     };
   };
@@ -210,10 +217,11 @@ inline MethodSpec nystrom_adaptive(const std::string& name, double ecc, long per
       opt.h0 = 1e-3;
       auto proto = std::make_shared<AdaptiveRknIntegrator<Vec2, CountingKepler>>(
           make_adaptive_integrator<Vec2>(def, CountingKepler{c}, opt));
-      return [proto, ecc, periods](State<Vec2>& s, long& steps, double& t_end) {
+      return [proto, ecc, periods](State<Vec2>& s, long& steps, EndTime& end) {
         auto integ = *proto;
         s = start(ecc);
-        t_end = period() * static_cast<double>(periods);
+        const double t_end = period() * static_cast<double>(periods);
+        end = {t_end, 1};
         const AdaptiveStats st = integ.integrate_to(s, 0.0, t_end);
         steps = st.accepted;
       };
@@ -246,10 +254,11 @@ inline MethodSpec nystrom_adaptive_mpe(const std::string& name, double ecc, long
       eo.compensated = compensated ? Compensation::on : Compensation::off;
       auto proto = std::make_shared<AdaptiveMpeIntegrator<Vec2, CountingKepler>>(
           make_adaptive_mpe_integrator<Vec2>(def, CountingKepler{c}, opt, eo));
-      return [proto, ecc, periods](State<Vec2>& s, long& steps, double& t_end) {
+      return [proto, ecc, periods](State<Vec2>& s, long& steps, EndTime& end) {
         auto integ = *proto;
         s = start(ecc);
-        t_end = period() * static_cast<double>(periods);
+        const double t_end = period() * static_cast<double>(periods);
+        end = {t_end, 1};
         const AdaptiveStats st = integ.integrate_to(s, 0.0, t_end);
         steps = st.accepted;
       };
@@ -269,10 +278,11 @@ inline MethodSpec nystrom_gbs(double ecc, long periods) {
       GbsOptions opt;
       opt.rtol = opt.atol = tol;
       auto proto = std::make_shared<GbsIntegrator<Vec2, CountingKepler>>(CountingKepler{c}, opt);
-      return [proto, ecc, periods](State<Vec2>& s, long& steps, double& t_end) {
+      return [proto, ecc, periods](State<Vec2>& s, long& steps, EndTime& end) {
         auto integ = *proto;
         s = start(ecc);
-        t_end = period() * static_cast<double>(periods);
+        const double t_end = period() * static_cast<double>(periods);
+        end = {t_end, 1};
         integ.integrate_to(s, t_end);
         steps = integ.steps();
       };
@@ -290,14 +300,14 @@ namespace oi = boost::numeric::odeint;
 /// by `in` and `out`.
 template <class Stepper, class Sys, class X, class In, class Out>
 Run odeint_fixed_run(Sys sys, In in, Out out, double ecc, long n, double h) {
-  return [sys, in, out, ecc, n, h](State<Vec2>& s, long& steps, double& t_end) {
+  return [sys, in, out, ecc, n, h](State<Vec2>& s, long& steps, EndTime& end) {
     Stepper stepper;
     X x = in(start(ecc));
     double t = 0;
     for (long i = 0; i < n; ++i, t += h) stepper.do_step(sys, x, t, h);
     s = out(x);
     steps = n;
-    t_end = h * static_cast<double>(n);
+    end = {h, n};
   };
 }
 
@@ -363,10 +373,11 @@ inline MethodSpec odeint_rkf78(double ecc, long periods) {
 /// `make_stepper`.
 template <class MakeStepper>
 Run odeint_adaptive_run(MakeStepper make_stepper, ForceCounter* c, double ecc, long periods) {
-  return [make_stepper, c, ecc, periods](State<Vec2>& s, long& steps, double& t_end) {
+  return [make_stepper, c, ecc, periods](State<Vec2>& s, long& steps, EndTime& end) {
     auto stepper = make_stepper();
     Vec4 y = to_vec4(start(ecc));
-    t_end = period() * static_cast<double>(periods);
+    const double t_end = period() * static_cast<double>(periods);
+    end = {t_end, 1};
     steps = static_cast<long>(
         oi::integrate_adaptive(stepper, CountingKeplerSystem{CountingKepler{c}}, y, 0.0, t_end, 1e-3));
     s = from_vec4(y);
@@ -429,11 +440,11 @@ inline Outcome timed(const Run& run, ForceCounter& counter, double ecc, const Pe
     counter.calls = 0;
     State<Vec2> s;
     long steps = 0;
-    double t_end = 0;
+    EndTime end;
     Outcome o;
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      run(s, steps, t_end);
+      run(s, steps, end);
       o.ok = true;
     } catch (const BudgetExceeded&) {
       o.ok = false;
@@ -447,7 +458,7 @@ inline Outcome timed(const Run& run, ForceCounter& counter, double ecc, const Pe
     ++reps;
     if (!o.ok) return o;  // failures are not repeated
     o.steps = steps;
-    o.error = detail::position_error(ecc, s, t_end);
+    o.error = detail::position_error(ecc, s, end);
     if (!std::isfinite(o.error)) {
       o.ok = false;  // diverged (NaN or infinite): a failure, not repeated
       return o;
