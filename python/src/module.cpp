@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "experiments/kepler.hpp"
+#include "flows_binding.hpp"
 #include "langevin_binding.hpp"
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/analysis/bch_report.hpp"
@@ -30,7 +31,6 @@
 #include "nystrom/engines/mpe.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/problems/plummer.hpp"
-#include "flows_binding.hpp"
 #include "solve_binding.hpp"
 #ifdef NYSTROM_PYTHON_QUANTUM
 #include "diffusion_binding.hpp"
