@@ -260,6 +260,12 @@ std::string first_order_refusal(const std::string& name) {
          "' does not integrate first-order systems y' = f(t, y); methods that do: " + velocity_list();
 }
 
+void require_first_order(const MethodDef& method) {
+  if (!method.info.velocity) throw invalid_input(first_order_refusal(method.info.name));
+}
+
+void require_first_order(const std::string& method) { require_first_order(resolve_solve_method(method)); }
+
 MethodDef resolve_solve_method(const std::string& spec) {
   if (spec == "GBS" || spec == "gbs") return gbs_method_def();
   if (detail::lower(spec).rfind("mpe-midpoint:", 0) == 0) {

@@ -43,10 +43,26 @@ void expect_bitwise(const Solution<Vd>& a, const Solution<Vd>& b) {
 }
 
 // Kepler e = 0.5 on std::vector<double>, a generic force (complex-coefficient methods run on it too).
+// `resize`: it assigns a vector of one component to its output instead (a force that must be refused).
 struct VecKepler {
+  bool resize = false;
   template <class V>
   void operator()(const V& q, V& a) const {
-    KeplerForce{}(q, a);
+    if (resize)
+      a = V{-q[0]};
+    else
+      KeplerForce{}(q, a);
+  }
+};
+
+// A driven oscillator q'' = -q + cos(2t); `resize`: it assigns a vector of three components to its output.
+struct Driven {
+  bool resize = false;
+  void operator()(double t, const Vd& q, Vd& a) const {
+    if (resize)
+      a = Vd{-q[0], 0.0, 0.0};
+    else
+      a[0] = -q[0] + std::cos(2 * t);
   }
 };
 
@@ -81,8 +97,7 @@ TEST(Compiled, EveryCatalogMethodIsBitwiseTheInlinePathBothDirections) {
 
 TEST(Compiled, TimeDependentForceOutputTimesEventsAndCheckpointsAreBitwiseTheInlinePath) {
   // A driven oscillator q'' = -q + cos(2t): q(t) = (4/3) cos t - (1/3) cos 2t from q(0) = 1, v(0) = 0.
-  auto force = [](double t, const Vd& q, Vd& a) { a[0] = -q[0] + std::cos(2 * t); };
-  const SecondOrderProblem prob(force, Vd{1.0}, Vd{0.0}, 0.0, 7.0);
+  const SecondOrderProblem prob(Driven{}, Vd{1.0}, Vd{0.0}, 0.0, 7.0);
   const std::vector<Event<Vd>> events = {{.name = "zero", .g = [](double, const Vd& q, const Vd&) { return q[0]; }}};
   for (const std::string m : {"M8", "KL8", "DP12-adaptive", "M12-adaptive", "GBS"}) {
     SCOPED_TRACE(m);
@@ -135,17 +150,27 @@ TEST(Compiled, DenseOutputOutlivesTheCallAndTheForceCopyIsIndependent) {
 }
 
 TEST(Compiled, AForceThatResizesItsOutputIsRefused) {
-  auto bad = [](const Vd& q, Vd& a) { a = Vd{-q[0]}; };  // drops the second component
-  const SecondOrderProblem prob(bad, Vd{1.0, 0.0}, Vd{0.0, 1.0}, 0.0, 1.0);
-  for (const std::string m : {"VV", "M8", "DP12-adaptive", "GBS"}) {
-    SCOPED_TRACE(m);
-    const SolveOptions opt = m == "VV" || m == "M8" ? SolveOptions{.steps = 10} : SolveOptions{.rtol = 1e-8};
+  // On the compiled path and on the inline one, time-independent and time-dependent, in both directions.
+  const SecondOrderProblem prob(VecKepler{true}, Vd{1.0, 0.0}, Vd{0.0, 1.0}, 0.0, 1.0);
+  const SecondOrderProblem back(VecKepler{true}, Vd{1.0, 0.0}, Vd{0.0, 1.0}, 1.0, 0.0);
+  const SecondOrderProblem prob_t(Driven{true}, Vd{1.0, 0.0}, Vd{0.0, 1.0}, 0.0, 1.0);
+  auto refused = [](auto&& run) {
     try {
-      (void)solve(prob, m, opt);
+      (void)run();
       ADD_FAILURE() << "not refused";
     } catch (const invalid_input& e) {
       EXPECT_NE(std::string(e.what()).find("changed the size of its output"), std::string::npos) << e.what();
     }
+  };
+  for (const std::string m : {"VV", "M8", "DP12-adaptive", "GBS"}) {
+    SCOPED_TRACE(m);
+    const SolveOptions opt = m == "VV" || m == "M8" ? SolveOptions{.steps = 10} : SolveOptions{.rtol = 1e-8};
+    refused([&] { return solve(prob, m, opt); });
+    refused([&] { return solve(back, m, opt); });
+    refused([&] { return solve(prob_t, m, opt); });
+    refused([&] { return solve_inline(prob, m, opt); });
+    refused([&] { return solve_inline(back, m, opt); });
+    refused([&] { return solve_inline(prob_t, m, opt); });
   }
 }
 

@@ -25,7 +25,6 @@
 #include <vector>
 
 #include "nystrom/core/error.hpp"
-#include "nystrom/methods/catalog.hpp"
 #include "nystrom/solve/checkpoint.hpp"
 #include "nystrom/solve/compiled.hpp"
 #include "nystrom/solve/dense.hpp"
@@ -86,24 +85,36 @@ Solution<V> resume(const SecondOrderProblem<V, F>& problem, const std::string& m
   }
 }
 
+/// Throws invalid_input (methods/catalog.hpp's first_order_refusal line) unless the method integrates
+/// first-order systems (the methods for velocity-dependent forces). In libnystrom.
+void require_first_order(const MethodDef& method);
+/// The same for a method given by its specification (resolved in libnystrom).
+void require_first_order(const std::string& method);
+
+namespace first_order_detail {
+template <class V, class F, class M>
+FirstOrderSolution<V> solve_first_order(const FirstOrderProblem<V, F>& problem, const M& method,
+                                        const SolveOptions& options, const std::vector<FirstOrderEvent<V>>& events) {
+  require_first_order(method);
+  const SecondOrderProblem<V, FirstOrderForce<V, F>> p(FirstOrderForce<V, F>{problem.fun}, zeros_like(problem.y0),
+                                                       problem.y0, problem.t0, problem.t1);
+  return from_second_order(solve(p, method, options, second_order_events(events)));
+}
+}  // namespace first_order_detail
+
 /// Integrates a first-order system y' = f(t, y) (solve/first_order.hpp) with a method for velocity-dependent
-/// forces (GBS); any other method is refused with first_order_refusal's line (invalid_input).
+/// forces (GBS, mpe-midpoint:K1,K2,...); any other method is refused with one line (invalid_input).
 template <class V, class F>
 FirstOrderSolution<V> solve(const FirstOrderProblem<V, F>& problem, const MethodDef& method,
                             const SolveOptions& options = {}, const std::vector<FirstOrderEvent<V>>& events = {}) {
-  if (!method.info.velocity) throw invalid_input(first_order_refusal(method.info.name));
-  const SecondOrderProblem<V, FirstOrderForce<V, F>> p(FirstOrderForce<V, F>{problem.fun},
-                                                       first_order_detail::zeros_like(problem.y0), problem.y0,
-                                                       problem.t0, problem.t1);
-  return first_order_detail::from_second_order(
-      solve(p, method, options, first_order_detail::second_order_events(events)));
+  return first_order_detail::solve_first_order(problem, method, options, events);
 }
 
 /// The same with the method given by its specification.
 template <class V, class F>
 FirstOrderSolution<V> solve(const FirstOrderProblem<V, F>& problem, const std::string& method,
                             const SolveOptions& options = {}, const std::vector<FirstOrderEvent<V>>& events = {}) {
-  return solve(problem, resolve_solve_method(method), options, events);
+  return first_order_detail::solve_first_order(problem, method, options, events);
 }
 
 }  // namespace nystrom

@@ -81,7 +81,12 @@ def _progress(progress):
                 bar = make_progress(True, 0, total)
             bar.update(done)
 
-        return update, lambda: bar is not None and bar.close()
+        def close(done):
+            # At the steps taken (an early stop by ``converge``), or, after an interrupt, at the last step reported.
+            if bar is not None:
+                bar.close(bar.t if done is None else done)
+
+        return update, close
     raise TypeError("progress must be True, False or a callable progress(done, total)")
 
 
@@ -228,13 +233,15 @@ def quantum(potential="harmonic", dims=1, grid=256, box=20.0, method=None, dt=0.
             raise ValueError(f"potential_values has shape {values.shape}, expected {expected} (grid points per axis)")
         values = np.ascontiguousarray(values, dtype=float).reshape(-1)
     prog = _progress(progress)
+    done = None  # the steps taken, once the run has returned
     try:
         d = _core.quantum(potential, values, initial, dims, grid, box, method, dt, steps, bool(imaginary_time),
                           x0, p0, width, g, states, precision, bool(autocorrelation), samples, threads, converge_tol,
                           bool(allow_negative_coefficients), None if prog is None else prog[0])
+        done = int(d["steps_taken"])
     finally:
         if prog is not None and prog[1] is not None:
-            prog[1]()
+            prog[1](done)
 
     res = QuantumResult()
     for key in ("method", "order", "dt", "time", "steps", "steps_taken", "norm", "norm_drift", "energy",

@@ -3,6 +3,7 @@
 import math
 import os
 import signal
+import sys
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
@@ -181,6 +182,20 @@ def test_progress_reports_steps_done_up_to_the_total():
     seen = []
     nystrom.quantum(**BIG, progress=lambda d, n: seen.append((d, n)))
     assert [d for d, _ in seen] == list(range(16, 97, 16)) and all(n == 96 for _, n in seen)
+
+
+def test_progress_line_ends_at_the_steps_taken(capsys, monkeypatch):
+    # The progress line (tqdm absent) closes at the steps the run took: all of them, or fewer when `converge`
+    # stopped it early; never at 100% for a run that did not take every step.
+    monkeypatch.setitem(sys.modules, "tqdm", None)
+    res = nystrom.quantum(grid=64, imaginary_time=True, x0=0.5, dt=0.05, steps=10000, converge=1e-8, progress=True)
+    last = capsys.readouterr().err.rstrip("\n").split("\r")[-1]
+    assert res.steps_taken < 10000
+    assert last.startswith(f"nystrom: t = {res.steps_taken} of 10000 (")
+    assert "100.0%" not in last
+    nystrom.quantum(grid=64, dt=0.05, steps=40, progress=True)
+    last = capsys.readouterr().err.rstrip("\n").split("\r")[-1]
+    assert last == "nystrom: t = 40 of 40 (100.0%)"
 
 
 @pytest.mark.skipif(os.name != "posix", reason="needs POSIX signals")

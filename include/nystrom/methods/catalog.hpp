@@ -59,6 +59,10 @@ std::string velocity_refusal(const std::string& name);
 /// The one-line refusal of method `name` for a first-order system y' = f(t, y) (which runs with the same
 /// methods).
 std::string first_order_refusal(const std::string& name);
+/// Throws invalid_input with that line unless the method integrates first-order systems (also declared in
+/// the light <nystrom/solve.hpp>).
+void require_first_order(const MethodDef& method);
+void require_first_order(const std::string& method);
 
 /// What solve() resolves: resolve_method(spec), "GBS" (or "gbs") for the extrapolation integrator, and
 /// "mpe-midpoint:K1,K2,..." (midpoint_mpe_method_def).

@@ -53,6 +53,7 @@
 #include "nystrom/problems/counting_force.hpp"
 #include "nystrom/solve/checkpoint.hpp"
 #include "nystrom/solve/dense.hpp"
+#include "nystrom/solve/erased_force.hpp"  // erased_detail::resized
 #include "nystrom/solve/options.hpp"
 #include "nystrom/solve/problem.hpp"
 #include "nystrom/solve/recorder.hpp"
@@ -93,6 +94,7 @@ struct EngineForce {
   void operator()(const VE& q, VE& a) requires(!VD) {
     if constexpr (!TD) {
       f(q, a);
+      check_size(a, q.size());
     } else {
       using R = real_t<typename V::value_type>;
       resize_like_n(qb, n);
@@ -100,6 +102,7 @@ struct EngineForce {
       for (std::size_t i = 0; i < n; ++i) qb[i] = q[i];
       const R t = dir > 0 ? R(q[n]) : R(-q[n]);
       f(t, static_cast<const V&>(qb), ab);
+      check_size(ab, n);
       for (std::size_t i = 0; i < n; ++i) a[i] = ab[i];
       a[n] = typename VE::value_type(0);
     }
@@ -109,11 +112,12 @@ struct EngineForce {
     if constexpr (!TD) {
       if (dir > 0) {
         f(q, v, a);
-        return;
+      } else {
+        resize_like_n(vb, n);
+        for (std::size_t i = 0; i < n; ++i) vb[i] = -v[i];
+        f(q, static_cast<const V&>(vb), a);
       }
-      resize_like_n(vb, n);
-      for (std::size_t i = 0; i < n; ++i) vb[i] = -v[i];
-      f(q, static_cast<const V&>(vb), a);
+      check_size(a, q.size());
     } else {
       resize_like_n(qb, n);
       resize_like_n(vb, n);
@@ -124,8 +128,19 @@ struct EngineForce {
       }
       const R t = dir > 0 ? R(q[n]) : R(-q[n]);
       f(t, static_cast<const V&>(qb), static_cast<const V&>(vb), ab);
+      check_size(ab, n);
       for (std::size_t i = 0; i < n; ++i) a[i] = ab[i];
       a[n] = typename VE::value_type(0);
+    }
+  }
+  // A force that assigned a vector of another size to its output (a = V{...}) is refused before the engine
+  // reads past its end (on the compiled path ErasedForce checks the same).
+  template <class X>
+  static void check_size(const X& a, std::size_t want) {
+    if constexpr (!is_std_array<X>::value) {
+      if (a.size() != want) erased_detail::resized(a.size(), want);
+    } else {
+      (void)a, (void)want;
     }
   }
   static void resize_like_n(V& x, std::size_t m) {
