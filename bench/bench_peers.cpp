@@ -27,8 +27,8 @@ void per_step(benchmark::State& st, np::MethodSpec m) {
     counter.calls = 0;
     nystrom::State<np::Vec2> s;
     long n = 0;
-    double t_end = 0;
-    run(s, n, t_end);
+    np::EndTime end;
+    run(s, n, end);
     benchmark::DoNotOptimize(s);
     steps += n;
     forces += counter.calls;
