@@ -16,6 +16,7 @@ import numbers
 import os
 
 from . import _core
+from ._progress import counted_progress
 from ._result import AttrDict
 
 __all__ = ["langevin", "LangevinResult"]
@@ -66,26 +67,6 @@ def _sequence(extrapolate):
     except TypeError:
         raise TypeError("extrapolate must be a sequence of positive integers such as [1, 2, 3]") from None
     return [_integer("extrapolate", k, 1, 1000000) for k in seq]
-
-
-def _progress(progress):
-    if progress is None or progress is False:
-        return None, None
-    if callable(progress):
-        return progress, None
-    if progress is True:
-        from ._progress import make_progress
-
-        bar = None
-
-        def update(done, total):
-            nonlocal bar
-            if bar is None:
-                bar = make_progress(True, 0, total)
-            bar.update(done)
-
-        return update, lambda: bar is not None and bar.close()
-    raise TypeError("progress must be True, False or a callable progress(done, total)")
 
 
 _CHUNK = 64  # paths per chunk of the library's deterministic reduction (nystrom/stochastic/langevin.hpp)
@@ -184,10 +165,12 @@ def langevin(potential="harmonic", gamma=1.0, kT=1.0, method="BAOAB", h=0.05, t_
     if threads == 0:
         threads = min(os.cpu_count() or 1, 64)
     request = _core.LangevinRequest(potential, omega, gamma, kT, q0, v0, method, h, t_end, paths, seed, seq, threads)
-    update, close = _progress(progress)
+    update, close = counted_progress(progress)
+    done = None  # the paths run, once the run has returned
     try:
         d = _core.langevin(request, update)
+        done = paths
     finally:
         if close is not None:
-            close()
+            close(done)
     return LangevinResult(d)

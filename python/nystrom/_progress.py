@@ -74,3 +74,29 @@ def make_progress(progress, t0, t1):
             return _Line(t0, t1)
         return _Tqdm(tqdm, t0, t1)
     raise TypeError("progress must be True, False or a callable progress(t)")
+
+
+def counted_progress(progress):
+    """``(update, close)`` for a run that reports how many of its ``total`` units (steps, paths) are done:
+    ``(None, None)`` without progress; a callable ``progress(done, total)`` is called as it is; True draws a
+    progress display, opened at the first report. ``close(done)`` ends the display at the units the run
+    took; ``close(None)`` (an interrupted run) at the last count reported, never at the total."""
+    if progress is None or progress is False:
+        return None, None
+    if callable(progress):
+        return progress, None
+    if progress is True:
+        bar = None
+
+        def update(done, total):
+            nonlocal bar
+            if bar is None:
+                bar = make_progress(True, 0, total)
+            bar.update(done)
+
+        def close(done):
+            if bar is not None:
+                bar.close(bar.t if done is None else done)
+
+        return update, close
+    raise TypeError("progress must be True, False or a callable progress(done, total)")

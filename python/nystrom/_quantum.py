@@ -15,6 +15,7 @@ import numbers
 import numpy as np
 
 from . import _core
+from ._progress import counted_progress
 from ._result import AttrDict
 
 __all__ = ["quantum", "QuantumResult"]
@@ -63,31 +64,6 @@ def _vector(name, x):
     if arr.ndim > 1:
         raise ValueError(f"{name} must be a number or a sequence of numbers, got shape {arr.shape}")
     return [float(v) for v in arr.reshape(-1)]
-
-
-def _progress(progress):
-    if progress is None or progress is False:
-        return None
-    if callable(progress):
-        return progress, None
-    if progress is True:
-        from ._progress import make_progress
-
-        bar = None
-
-        def update(done, total):
-            nonlocal bar
-            if bar is None:
-                bar = make_progress(True, 0, total)
-            bar.update(done)
-
-        def close(done):
-            # At the steps taken (an early stop by ``converge``), or, after an interrupt, at the last step reported.
-            if bar is not None:
-                bar.close(bar.t if done is None else done)
-
-        return update, close
-    raise TypeError("progress must be True, False or a callable progress(done, total)")
 
 
 def quantum(potential="harmonic", dims=1, grid=256, box=20.0, method=None, dt=0.05, steps=200,
@@ -232,16 +208,16 @@ def quantum(potential="harmonic", dims=1, grid=256, box=20.0, method=None, dt=0.
         if expected is not None and values.shape != expected:
             raise ValueError(f"potential_values has shape {values.shape}, expected {expected} (grid points per axis)")
         values = np.ascontiguousarray(values, dtype=float).reshape(-1)
-    prog = _progress(progress)
+    update, close = counted_progress(progress)
     done = None  # the steps taken, once the run has returned
     try:
         d = _core.quantum(potential, values, initial, dims, grid, box, method, dt, steps, bool(imaginary_time),
                           x0, p0, width, g, states, precision, bool(autocorrelation), samples, threads, converge_tol,
-                          bool(allow_negative_coefficients), None if prog is None else prog[0])
+                          bool(allow_negative_coefficients), update)
         done = int(d["steps_taken"])
     finally:
-        if prog is not None and prog[1] is not None:
-            prog[1](done)
+        if close is not None:
+            close(done)
 
     res = QuantumResult()
     for key in ("method", "order", "dt", "time", "steps", "steps_taken", "norm", "norm_drift", "energy",
