@@ -5,6 +5,7 @@
 #include <cctype>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -200,17 +201,59 @@ MethodDef resolve_method(const std::string& spec) {
   }
 }
 
-MethodDef gbs_method_def() {
+MethodDef gbs_method_def(const GbsDef& gbs) {
+  if (gbs.max_columns < 3 || gbs.max_columns > 20)
+    throw invalid_input("GBS: the columns must be an integer between 3 and 20 (GBS:SEQUENCE:COLUMNS)");
+  static const char* const names[] = {"harmonic", "romberg", "bulirsch"};
+  const GbsDef defaults{};
   MethodDef d;
   d.info.name = "GBS";
+  if (gbs.sequence != defaults.sequence || gbs.max_columns != defaults.max_columns)
+    d.info.name += std::string(":") + names[static_cast<int>(gbs.sequence)] +
+                   (gbs.max_columns != defaults.max_columns ? ":" + std::to_string(gbs.max_columns) : "");
   d.info.family = "extrapolation";
+  d.info.order = 2 * gbs.max_columns;
+  d.info.symmetric = true;  // the modified midpoint rule that it extrapolates
   d.info.adaptive = true;
   d.info.velocity = true;
   d.info.source = "Gragg (1965); Bulirsch & Stoer (1966); Hairer, Norsett & Wanner I, sec. II.9/II.14 (ODEX2)";
-  d.info.description = "Gragg-Bulirsch-Stoer extrapolation, adaptive step and order";
-  d.build = []() -> MethodData { throw invalid_input("GBS has no coefficient table"); };
+  d.info.description = std::string("Gragg-Bulirsch-Stoer extrapolation, adaptive step and order up to ") +
+                       std::to_string(2 * gbs.max_columns) + ", " + names[static_cast<int>(gbs.sequence)] +
+                       " step numbers";
+  d.build = [gbs]() -> MethodData { return gbs; };
   return d;
 }
+
+namespace {
+
+/// "GBS", "GBS:SEQUENCE" or "GBS:SEQUENCE:COLUMNS" (case-insensitive); nullopt for any other spec.
+std::optional<MethodDef> gbs_spec(const std::string& spec) {
+  const std::string ls = detail::lower(spec);
+  if (ls != "gbs" && ls.rfind("gbs:", 0) != 0) return std::nullopt;
+  GbsDef g;
+  if (ls == "gbs") return gbs_method_def(g);
+  const std::string rest = ls.substr(4);
+  const auto colon = rest.find(':');
+  const std::string seq = rest.substr(0, colon);
+  if (seq == "harmonic")
+    g.sequence = GbsSequence::harmonic;
+  else if (seq == "romberg")
+    g.sequence = GbsSequence::romberg;
+  else if (seq == "bulirsch")
+    g.sequence = GbsSequence::bulirsch;
+  else
+    throw invalid_input("GBS: unknown step-number sequence '" + seq.substr(0, 40) +
+                        "' (known: harmonic, romberg, bulirsch; GBS:SEQUENCE:COLUMNS)");
+  if (colon != std::string::npos) {
+    const std::string cols = rest.substr(colon + 1);
+    if (cols.empty() || cols.size() > 2 || cols.find_first_not_of("0123456789") != std::string::npos)
+      throw invalid_input("GBS: the columns must be an integer between 3 and 20 (GBS:SEQUENCE:COLUMNS)");
+    g.max_columns = std::stoi(cols);
+  }
+  return gbs_method_def(g);
+}
+
+}  // namespace
 
 MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string& name) {
   try {
@@ -231,6 +274,12 @@ MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string&
   d.info.description = "multi-product expansion over Gragg's modified midpoint rule (2k substeps), fixed step";
   d.build = [k]() -> MethodData { return MpeDef{k, "GM", {}, false}; };
   return d;
+}
+
+std::vector<MethodDef> listed_methods() {
+  std::vector<MethodDef> out = catalog();
+  out.push_back(gbs_method_def());
+  return out;
 }
 
 std::vector<std::string> velocity_methods() {
@@ -267,7 +316,7 @@ void require_first_order(const MethodDef& method) {
 void require_first_order(const std::string& method) { require_first_order(resolve_solve_method(method)); }
 
 MethodDef resolve_solve_method(const std::string& spec) {
-  if (spec == "GBS" || spec == "gbs") return gbs_method_def();
+  if (auto g = gbs_spec(spec)) return *g;
   if (detail::lower(spec).rfind("mpe-midpoint:", 0) == 0) {
     std::vector<long> k;
     try {

@@ -103,8 +103,10 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
       "- `adjoint:NAME`: the adjoint of a splitting method.\n"
       "- `file:PATH`: a splitting method in a text file of drifts and kicks, written by `nystrom discover --write` or\n"
       "  by hand (format: include/nystrom/analysis/method_file.hpp); its declared order is verified on loading.\n\n"
-      "The command-line tool also runs `GBS`, Gragg-Bulirsch-Stoer extrapolation with Hairer's order and step\n"
-      "control, given a tolerance (`nystrom run --method GBS --tol 1e-12`); it serves as the reference solution.\n\n"
+      "- `GBS:SEQUENCE` and `GBS:SEQUENCE:COLUMNS`: the table's `GBS` (Gragg-Bulirsch-Stoer extrapolation with\n"
+      "  Hairer's order and step control, given a tolerance) with the step numbers `harmonic` (2, 4, 6, ..., the\n"
+      "  default), `romberg` (2, 4, 8, ...) or `bulirsch` (2, 4, 6, 8, 12, ...) and 3 to 20 columns (default 12):\n"
+      "  `GBS:bulirsch:10`. Its stages and forces per step are listed as 0: they vary with the order it chooses.\n\n"
       "## Velocity-dependent forces\n\n"
       "A force a(t, q, v) (`force(q, v, a)` or `force(t, q, v, a)` in C++, `force(t, q, v)` in Python; `nystrom run\n"
       "--problem arenstorf` or `damped-oscillator`) runs only with the methods for y'' = f(t, y, y'): " +
@@ -134,7 +136,7 @@ nystrom::cli::Registrar reg("methods", "List every method in the catalog", [](CL
   auto* json_flag = app.add_flag("--json", *json, "Print one JSON array");
   app.add_flag("--markdown", *markdown, "Print the catalog page docs/methods.md")->excludes(json_flag);
   return [json, markdown]() {
-    const auto& cat = nystrom::catalog();
+    const auto cat = nystrom::listed_methods();
     if (*markdown) {
       std::cout << markdown_page(cat);
       return 0;
@@ -153,7 +155,9 @@ nystrom::cli::Registrar reg("methods", "List every method in the catalog", [](CL
       fmt::print("{:<12} {:<12} {:>5} {:>6} {:>6} {:>4} {:>4} {:>5} {:>4}  {}\n", m.name, m.family, m.order, m.stages,
                  m.forces_per_step, yn(m.fsal), yn(m.symmetric), yn(m.symplectic), yn(m.complex), m.source);
     }
-    fmt::print("\nAlso: M<2n> (any even order), mpe:K1,K2,... (PV base), mpe-vv:K1,K2,..., adjoint:NAME.\n");
+    fmt::print(
+        "\nAlso: M<2n> (any even order), mpe:K1,K2,... (PV base), mpe-vv:K1,K2,..., adjoint:NAME, "
+        "GBS:SEQUENCE[:COLUMNS] (harmonic, romberg, bulirsch; 3 to 20 columns).\n");
     fmt::print("Velocity-dependent forces a(t, q, v) run with: {} (every other method is for a(t, q)).\n",
                join(nystrom::velocity_methods(), ", "));
     fmt::print("\nPlanetary maps (run --problem outer-solar-system; also WH-NAME, WHD-NAME for catalog methods):\n");

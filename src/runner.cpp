@@ -53,7 +53,7 @@ void RunMeter::finish() {
 
 // Defined in runner_typed.hpp, instantiated for each precision in runner_<precision>.cpp.
 template <class T>
-RunReport run_in_precision(const RunRequest& req, const MethodDef& def, bool gbs);
+RunReport run_in_precision(const RunRequest& req, const MethodDef& def);
 
 nlohmann::json RunReport::to_json() const {
   nlohmann::json j{{"method", method},
@@ -106,8 +106,12 @@ RunReport run_nbody_case(const RunRequest& req, const MethodDef& def) {
     h = 2 * std::acos(-1.0) / static_cast<double>(req.steps_per_period);
     steps = req.steps_per_period * req.periods;
   }
-  const bool gbs = def.info.family == "extrapolation";
-  const auto r = run_nbody(gbs ? "GBS" : def.info.name, setup, h, steps, gbs ? req.tol : 0.0);
+  NBodyRunResult r;
+  try {
+    r = run_nbody(def.info.name, setup, h, steps, def.info.adaptive ? req.tol : 0.0);
+  } catch (const invalid_input& e) {
+    throw UsageError(e.what());
+  }
   RunReport out;
   out.ecc = req.problem == "twobody" ? req.ecc : RunReport::nan;
   out.steps = r.steps;
@@ -145,10 +149,8 @@ RunReport run_case(const RunRequest& req, const MethodDef& def) {
     r.precision = req.precision;
     return r;
   }
-  const bool gbs = def.info.family == "extrapolation";
-  RunReport r = dispatch_precision(req.precision, [&](auto tag) -> RunReport {
-    return run_in_precision<typename decltype(tag)::type>(req, def, gbs);
-  });
+  RunReport r = dispatch_precision(
+      req.precision, [&](auto tag) -> RunReport { return run_in_precision<typename decltype(tag)::type>(req, def); });
   r.method = def.info.name;
   r.family = def.info.family;
   r.order = def.info.order;

@@ -1,5 +1,6 @@
 // `nystrom run --problem kepler` through solve(): output times from the dense output, events,
 // checkpoint and restart (double precision).
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -112,7 +113,8 @@ SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq,
     opt.rtol = req.tol;
   else
     opt.steps = req.steps_per_period * req.periods;
-  opt.engine.keep_complex = req.keep_complex;
+  opt.max_steps = std::max(opt.max_steps, opt.steps);
+  opt.keep_complex = req.keep_complex;
   opt.dense = false;  // output times and events are taken as the run goes (partial steps of the method)
   if (!sreq.output_times.empty()) opt.t_eval = parse_output_times(sreq.output_times);
   for (double t : opt.t_eval)

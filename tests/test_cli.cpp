@@ -55,12 +55,16 @@ TEST(Cli, MethodsJsonListsTheCatalog) {
                             "source", "fsal", "stages"})
       EXPECT_TRUE(m.contains(key)) << key;
     EXPECT_GT(m["order"].get<int>(), 0);
-    EXPECT_GT(m["force_evals_per_step"].get<int>(), 0);
+    // GBS's cost per step varies with the order it chooses: listed as 0, and only there
+    EXPECT_EQ(m["force_evals_per_step"].get<int>() > 0, m["family"] != "extrapolation") << m["name"];
     EXPECT_FALSE(m["source"].get<std::string>().empty());
     names.insert(m["name"]);
   }
-  for (const char* n : {"VV", "PV", "FR", "N4", "M4", "M6", "M6-5F", "A6", "Aprime", "M8", "M16"})
+  for (const char* n : {"VV", "PV", "FR", "N4", "M4", "M6", "M6-5F", "A6", "Aprime", "M8", "M16", "GBS"})
     EXPECT_TRUE(names.count(n)) << n;
+  EXPECT_EQ(j.back()["name"], "GBS");
+  EXPECT_EQ(j.back()["order"], 24);  // 12 columns
+  EXPECT_TRUE(j.back()["adaptive"].get<bool>());
 }
 
 TEST(Cli, CoeffsMpeAreExactFractions) {

@@ -216,3 +216,33 @@ TEST(CliSolve, RestartFromACheckpointEndsInBitwiseTheSameState) {
   EXPECT_EQ(ev.code, 2);
   std::filesystem::remove_all(dir);
 }
+
+TEST(CliSolve, PlainRunsAndRunsWithOutputTimesAreOneSolveBitwise) {
+  // `run` reaches every method through solve(): a run with output times (partial steps on the side) ends in
+  // bitwise the same state as the plain run, for fixed steps, an adaptive pair and GBS with its sequence.
+  for (const std::string method : {"M8 --steps-per-period 500", "DP12-adaptive --tol 1e-11", "GBS:romberg --tol 1e-11",
+                                   "Chambers --steps-per-period 800"}) {
+    SCOPED_TRACE(method);
+    const std::string base = "run --problem kepler --ecc 0.7 --periods 2 --json --method " + method;
+    const auto plain = run(base), timed = run(base + " --output-times 0:3:4");
+    ASSERT_EQ(plain.code, 0) << plain.err;
+    ASSERT_EQ(timed.code, 0) << timed.err;
+    const auto a = nlohmann::json::parse(plain.out), b = nlohmann::json::parse(timed.out);
+    EXPECT_EQ(a.at("q"), b.at("q"));
+    EXPECT_EQ(a.at("v"), b.at("v"));
+    EXPECT_EQ(a.at("force_evals"), b.at("force_evals"));
+    EXPECT_EQ(a.at("steps"), b.at("steps"));
+    EXPECT_LT(a.at("position_error").get<double>(), 1e-6);
+  }
+  // the harmonic oscillator takes adaptive methods too, and GBS reports the order it can reach
+  const auto h = run("run --problem harmonic --method DP12-adaptive --tol 1e-12 --periods 3 --json");
+  ASSERT_EQ(h.code, 0) << h.err;
+  EXPECT_LT(nlohmann::json::parse(h.out).at("position_error").get<double>(), 1e-10);
+  const auto g = run("run --problem kepler --ecc 0.5 --method GBS:bulirsch:8 --tol 1e-10 --periods 1 --json");
+  ASSERT_EQ(g.code, 0) << g.err;
+  EXPECT_EQ(nlohmann::json::parse(g.out).at("order"), 16);
+  EXPECT_EQ(nlohmann::json::parse(g.out).at("method"), "GBS:bulirsch:8");
+  const auto bad = run("run --problem kepler --method GBS:fibonacci --tol 1e-10");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("unknown step-number sequence 'fibonacci'"), std::string::npos) << bad.err;
+}

@@ -124,11 +124,11 @@ TEST(Solve, CapturingLambdaOnAVectorStateRunsEveryEngineAndSchedule) {
   };
   const SecondOrderProblem prob(f, std::vector<double>{1.0, 0.0}, std::vector<double>{0.0, w}, 0.0, 1.0);
   SolveOptions o{.steps = 200};
-  o.engine.mpe_schedule = MpeSchedule::concurrent;
+  o.mpe_schedule = MpeSchedule::concurrent;
   for (const std::string m : {"M8", "FR", "N4", "DP12-adaptive", "M10-adaptive"}) {
     SCOPED_TRACE(m);
     o.rtol = 1e-12;
-    if (m == "M10-adaptive") o.engine.mpe_schedule = MpeSchedule::automatic;
+    if (m == "M10-adaptive") o.mpe_schedule = MpeSchedule::automatic;
     const auto sol = solve(prob, m, o);
     EXPECT_NEAR(sol.q_final[0], std::cos(w), 1e-7);
     EXPECT_NEAR(sol.q_final[1], std::sin(w), 1e-7);
@@ -205,6 +205,62 @@ TEST(Solve, AdaptiveEnginesTakeSeparateAbsoluteAndRelativeTolerances) {
           SolveOptions{.rtol = 1e-9, .atol = NAN}, SolveOptions{.rtol = 0, .atol = 0}})
       EXPECT_THROW(solve(prob, m, bad), invalid_input);
   }
+}
+
+TEST(Solve, GbsTakesItsSequenceAndColumnsFromTheSpecification) {
+  // GBS is data: "GBS:SEQUENCE:COLUMNS". Every sequence reaches the orbit; they differ in cost, and fewer
+  // columns cap the order (order 2 x columns) and so need more steps.
+  const KeplerProblem<double> kp(0.5);
+  const double t1 = 2.5;
+  const auto prob = kepler(0.5, 0.0, t1);
+  const auto ex = kp.exact(t1);
+  long harmonic_evals = 0;
+  for (const std::string spec : {"GBS", "GBS:romberg", "GBS:bulirsch", "GBS:harmonic:4", "gbs:Bulirsch:8"}) {
+    SCOPED_TRACE(spec);
+    const auto sol = solve(prob, spec, {.rtol = 1e-11});
+    EXPECT_LT(pos_err(sol.q_final, ex), 1e-8);
+    if (spec == "GBS") harmonic_evals = sol.force_evals;
+    if (spec == "GBS:romberg" || spec == "GBS:bulirsch") {
+      EXPECT_NE(sol.force_evals, harmonic_evals);
+    }
+  }
+  const auto four = solve(prob, "GBS:harmonic:4", {.rtol = 1e-11}), twelve = solve(prob, "GBS", {.rtol = 1e-11});
+  EXPECT_GT(four.accepted, twelve.accepted);
+  EXPECT_EQ(resolve_solve_method("GBS:bulirsch:10").info.order, 20);
+  EXPECT_EQ(resolve_solve_method("GBS:bulirsch:10").info.name, "GBS:bulirsch:10");
+  EXPECT_EQ(resolve_solve_method("gbs:harmonic:12").info.name, "GBS");  // the defaults have the short name
+  EXPECT_EQ(resolve_solve_method("GBS").info.order, 24);
+  for (const std::string bad : {"GBS:fibonacci", "GBS:harmonic:2", "GBS:harmonic:21", "GBS:harmonic:x",
+                                "GBS:", "GBS:romberg:", "GBS:harmonic:100000000000000000000"})
+    EXPECT_THROW(resolve_solve_method(bad), invalid_input) << bad;
+  // listed after the catalog, as `nystrom methods` and nystrom.methods() show it
+  EXPECT_EQ(listed_methods().back().info.name, "GBS");
+  EXPECT_EQ(listed_methods().size(), catalog().size() + 1);
+}
+
+TEST(Solve, StepControlOptionsAreFlatAndRefusedWhereTheyDoNotApply) {
+  const auto prob = kepler(0.5, 0.0, 2.5);
+  // h_max bounds the adaptive step: at least span / h_max steps
+  const auto free = solve(prob, "DP12-adaptive", {.rtol = 1e-8});
+  const auto capped = solve(prob, "DP12-adaptive", {.rtol = 1e-8, .h_max = 0.01});
+  EXPECT_LT(free.accepted, 100);
+  EXPECT_GE(capped.accepted, 250);
+  // h0 is the first step of an adaptive method and of GBS: a given first step changes the run (and its cost)
+  const auto gbs = solve(prob, "GBS", {.rtol = 1e-10}), gbs_h0 = solve(prob, "GBS", {.rtol = 1e-10, .h0 = 0.01});
+  EXPECT_NE(gbs.force_evals, gbs_h0.force_evals);
+  const auto dp_h0 = solve(prob, "DP12-adaptive", {.rtol = 1e-8, .h0 = 1e-4});
+  EXPECT_NE(dp_h0.force_evals, free.force_evals);
+  // a smaller safety factor takes more, smaller steps
+  EXPECT_GT(solve(prob, "M10-adaptive", {.rtol = 1e-8, .safety = 0.5}).accepted,
+            solve(prob, "M10-adaptive", {.rtol = 1e-8}).accepted);
+  // options of a controller the method does not have are refused, not ignored
+  EXPECT_THROW(solve(prob, "M8", {.steps = 100, .safety = 0.5}), invalid_input);
+  EXPECT_THROW(solve(prob, "M8", {.steps = 100, .h0 = 0.1}), invalid_input);
+  EXPECT_THROW(solve(prob, "GBS", {.rtol = 1e-10, .h_max = 0.1}), invalid_input);
+  EXPECT_THROW(solve(prob, "GBS", {.rtol = 1e-10, .predictive = false}), invalid_input);
+  EXPECT_THROW(solve(prob, "DP12-adaptive", {.rtol = 1e-8, .h0 = -1}), invalid_input);
+  EXPECT_THROW(solve(prob, "DP12-adaptive", {.rtol = 1e-8, .safety = 1.5}), invalid_input);
+  EXPECT_THROW(solve(prob, "DP12-adaptive", {.rtol = 1e-8, .fac_max = 0.5}), invalid_input);
 }
 
 TEST(Solve, AForceReturningNaNIsReportedWithTheTime) {

@@ -214,17 +214,17 @@ PYBIND11_MODULE(_core, m) {
         // The catalog is built at its first use, which takes the precision lock: without the GIL.
         const auto infos = released([] {
           std::vector<MethodInfo> v;
-          for (const auto& d : catalog()) v.push_back(d.info);
+          for (const auto& d : listed_methods()) v.push_back(d.info);
           return v;
         });
         py::list out;
         for (const auto& info : infos) out.append(info_dict(info));
         return out;
       },
-      "Every method in the catalog, as a list of dicts.");
+      "Every method in the catalog, then GBS, as a list of dicts.");
   m.def(
       "method_info",
-      [](const std::string& spec) { return info_dict(released([&] { return resolve_method(spec).info; })); },
+      [](const std::string& spec) { return info_dict(released([&] { return resolve_solve_method(spec).info; })); },
       py::arg("spec"), "The catalog record of a method specification (a name, M<2n>, mpe:1,2,3, ...).");
   m.def("mpe_coeffs", &mpe_coeffs, py::arg("sequence"), "Exact multi-product coefficients of a sequence.");
   m.def(
@@ -321,7 +321,7 @@ PYBIND11_MODULE(_core, m) {
         if (t_eval) r.options.t_eval = *t_eval;
         r.options.dense = dense;
         r.options.max_steps = max_steps;
-        r.options.engine.keep_complex = keep_complex;
+        r.options.keep_complex = keep_complex;
         for (const auto& e : events) {
           const auto t = e.cast<py::tuple>();
           r.events.push_back({t[0], t[1].cast<int>(), t[2].cast<bool>(), t[3].cast<std::string>()});

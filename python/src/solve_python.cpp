@@ -89,7 +89,7 @@ struct PyVelocityForce {
 
 py::dict solve_python_force(py::object force, std::vector<py::ssize_t> shape, const SolveRequest& r, bool velocity) {
   SolveRequest req = r;
-  req.options.engine.mpe_schedule = MpeSchedule::sequential;  // one thread calls the force
+  req.options.mpe_schedule = MpeSchedule::sequential;  // one thread calls the force
   const std::size_t n = r.q0.size();
   if (velocity) return run_solve<std::vector<double>>(PyVelocityForce{{force, shape, n}}, req, true, true);
   return run_solve<std::vector<double>>(PyForce{force, std::move(shape), n}, req, true, true);

@@ -13,7 +13,7 @@ def test_methods_lists_families_with_their_fields():
             "adaptive", "published_digits", "aliases", "source", "description"}
     for m in cat:
         assert keys <= set(m)
-        assert m["family"] in {"splitting", "composition", "rkn", "mpe"}
+        assert m["family"] in {"splitting", "composition", "rkn", "mpe", "extrapolation"}
         assert m["order"] >= 2
     names = {m["name"]: m for m in cat}
     # Orders from the publications: Verlet 2, Forest-Ruth 4 (Chin 2010), DP12 12 (Dormand, El-Mikkawy, Prince).
@@ -21,6 +21,9 @@ def test_methods_lists_families_with_their_fields():
     assert names["FR"]["order"] == 4 and names["FR"]["symplectic"]
     assert names["DP12"]["family"] == "rkn" and names["DP12"]["order"] == 12
     assert names["Chambers"]["complex"]
+    # GBS closes the list: adaptive in step and order, up to order 2 x 12 columns by default.
+    assert cat[-1]["name"] == "GBS" and cat[-1]["family"] == "extrapolation"
+    assert cat[-1]["order"] == 24 and cat[-1]["adaptive"] and cat[-1]["forces_per_step"] == 0
 
 
 def test_method_info_resolves_specifications():
@@ -31,6 +34,13 @@ def test_method_info_resolves_specifications():
     assert nystrom.method_info("mpe:1,2,3")["order"] == 6
     with pytest.raises(ValueError, match="unknown method"):
         nystrom.method_info("NoSuchMethod")
+    # GBS with its sequence and columns in the specification: the order it can reach is 2 x columns
+    assert nystrom.method_info("GBS:bulirsch:10")["order"] == 20
+    assert nystrom.method_info("gbs:romberg")["name"] == "GBS:romberg"
+    with pytest.raises(ValueError, match="^GBS: unknown step-number sequence 'fibonacci'"):
+        nystrom.method_info("GBS:fibonacci")
+    with pytest.raises(ValueError, match="^GBS: the columns must be an integer between 3 and 20"):
+        nystrom.method_info("GBS:harmonic:40")
     with pytest.raises(TypeError):
         nystrom.method_info(8)
 

@@ -387,7 +387,7 @@ class AdaptiveMpeIntegrator {
     auto force = [&](const State<V>& y, V& ar) NYSTROM_ALWAYS_INLINE {
       if constexpr (local) {
         V q;  // a fresh local per call: no false dependence between the products' chains
-        for (std::size_t j = 0; j < n; ++j) q[j] = s.q[j] + y.q[j];
+        for (std::size_t j = 0; j < q.size(); ++j) q[j] = s.q[j] + y.q[j];  // std::array: q.size() == n
         base_.force()(q, ar);
       } else {
         for (std::size_t j = 0; j < n; ++j) qt[j] = s.q[j] + y.q[j];

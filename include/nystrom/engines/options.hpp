@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "nystrom/methods/gbs_def.hpp"
+
 namespace nystrom {
 
 struct AdaptiveOptions {
@@ -33,8 +35,6 @@ struct AdaptiveOptions {
     if (error_order < 0) throw std::invalid_argument("error_order must be >= 0");
   }
 };
-
-enum class GbsSequence { harmonic, romberg, bulirsch };
 
 struct GbsOptions {
   double rtol = 1e-12;

@@ -36,12 +36,17 @@ void finalize_info(MethodDef& d);
 /// All named methods, with derived fields filled in. Built once.
 const std::vector<MethodDef>& catalog();
 
+/// What `nystrom methods` and nystrom.methods() list: the catalog, then GBS (the one method of solve()
+/// without a coefficient table; its cost per step varies with its order, listed as 0 stages and forces).
+std::vector<MethodDef> listed_methods();
+
 /// Resolves a method specification (see the top of this file). Throws nystrom::invalid_input.
 MethodDef resolve_method(const std::string& spec);
 
 /// The Gragg-Bulirsch-Stoer extrapolation integrator (engines/gbs.hpp) as a method for solve(): adaptive
-/// step and order, tolerances rtol and atol (family "extrapolation"; no coefficient table).
-MethodDef gbs_method_def();
+/// step and order, tolerances rtol and atol (family "extrapolation"; its data is the GbsDef: the step-number
+/// sequence and the columns of the table). Named "GBS" with the defaults, else "GBS:SEQUENCE[:COLUMNS]".
+MethodDef gbs_method_def(const GbsDef& gbs = {});
 
 /// The multi-product expansion over Gragg's modified midpoint rule with sequence k (engines/mpe_midpoint.hpp):
 /// fixed steps, order 2 k.size(), for velocity-dependent forces and first-order systems ("mpe-midpoint:1,2,3";
@@ -64,7 +69,8 @@ std::string first_order_refusal(const std::string& name);
 void require_first_order(const MethodDef& method);
 void require_first_order(const std::string& method);
 
-/// What solve() resolves: resolve_method(spec), "GBS" (or "gbs") for the extrapolation integrator, and
+/// What solve() resolves: resolve_method(spec), "GBS", "GBS:SEQUENCE" or "GBS:SEQUENCE:COLUMNS" for the
+/// extrapolation integrator (sequence harmonic, romberg or bulirsch; columns 3 to 20, default harmonic:12), and
 /// "mpe-midpoint:K1,K2,..." (midpoint_mpe_method_def).
 MethodDef resolve_solve_method(const std::string& spec);
 

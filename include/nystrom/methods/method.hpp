@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "nystrom/core/bignum.hpp"
+#include "nystrom/methods/gbs_def.hpp"
 #include "nystrom/methods/mpe_coefficients.hpp"
 #include "nystrom/methods/rkn_tableau.hpp"
 #include "nystrom/methods/splitting_scheme.hpp"
@@ -43,7 +44,9 @@ struct MpeDef {
   bool order_control = false;
 };
 
-using MethodData = std::variant<SplittingScheme<bigcomplex>, RknTableau<bigcomplex>, MpeDef>;
+/// A method: a splitting scheme, an RKN tableau, a multi-product expansion, or Gragg-Bulirsch-Stoer
+/// extrapolation (GbsDef: adaptive step and order; solve() runs it, the fixed-step engines refuse it).
+using MethodData = std::variant<SplittingScheme<bigcomplex>, RknTableau<bigcomplex>, MpeDef, GbsDef>;
 
 struct MethodDef {
   MethodInfo info;

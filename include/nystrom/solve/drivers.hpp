@@ -325,7 +325,7 @@ struct Run {
   typename DenseOutput<V>::PartialStep propagated_method(const MethodDef& def) const {
     using T = real_t<typename VE::value_type>;
     const MethodData data = method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
-    return partial_step(Integrator<VE, Force>(data, force(), opt.engine));
+    return partial_step(Integrator<VE, Force>(data, force(), detail::engine_options(opt)));
   }
   void check_finite(const V& q, const V& v, const R& ta, const R& tb) const {
     if (!all_finite(q) || !all_finite(v)) throw not_finite(ta, tb);
@@ -475,7 +475,7 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
     n = std::max(1L, static_cast<long>(nd));
   }
   if (n > opt.max_steps) throw too_many_steps("the span needs " + std::to_string(n) + " steps, more than max_steps");
-  auto integ = make_fixed_engine<VE>(run, def, opt.engine);
+  auto integ = make_fixed_engine<VE>(run, def, detail::engine_options(opt));
   using Engine = decltype(integ);
   const R tau0 = sgn_mul(dir, prob.t0), tau1 = sgn_mul(dir, prob.t1);
   State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
@@ -540,7 +540,7 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
       c.step_index = k + 1;
       flatten(s.q, c.state);
       flatten(s.v, c.state);
-      if (use_compensation<typename VE::value_type>(opt.engine.compensated)) {
+      if (use_compensation<typename VE::value_type>(opt.compensated)) {
         flatten(integ.compensator().cq, c.carry);
         flatten(integ.compensator().cv, c.carry);
       }
@@ -612,7 +612,7 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const long& calls, const c
         flatten(s.q, c.state);
         flatten(s.v, c.state);
         if constexpr (requires { engine.compensator(); }) {
-          if (use_compensation<typename VE::value_type>(run.opt.engine.compensated)) {
+          if (use_compensation<typename VE::value_type>(run.opt.compensated)) {
             flatten(engine.compensator().cq, c.carry);
             flatten(engine.compensator().cv, c.carry);
           }
@@ -633,12 +633,17 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const long& calls, const c
 }
 
 template <class VE, class V, class F>
-void run_gbs(Run<V, F, VE>& run, Solution<V>& sol, const std::vector<Event<V>>& events,
+void run_gbs(Run<V, F, VE>& run, const MethodDef& def, Solution<V>& sol, const std::vector<Event<V>>& events,
              const Checkpoint<real_t<typename V::value_type>>* resume) {
   using R = real_t<typename V::value_type>;
   auto& prob = run.prob;
   const int dir = run.dir;
-  GbsOptions go = run.opt.gbs;
+  GbsOptions go;
+  const MethodData data = def.build();
+  const auto& gd = std::get<GbsDef>(data);
+  go.sequence = gd.sequence;
+  go.max_columns = gd.max_columns;
+  go.initial_step = run.opt.h0;
   go.rtol = run.opt.rtol;
   go.atol = run.opt.atol > 0 ? run.opt.atol : run.opt.rtol;
   go.max_steps = run.opt.max_steps;
@@ -705,6 +710,26 @@ inline void check_tolerances(const MethodDef& def, const SolveOptions& opt) {
     throw invalid_input("method '" + def.info.name + "' needs a tolerance (rtol > 0 or atol > 0)");
 }
 
+/// Throws invalid_input when an option of the step control is set for a method that has no use for it
+/// (instead of ignoring it): h0 applies to the adaptive methods and GBS, h_max, safety, fac_min, fac_max,
+/// predictive and error_order to the adaptive RKN and MPE methods.
+inline void check_step_control(const MethodDef& def, const SolveOptions& opt, bool gbs) {
+  const SolveOptions d{};
+  const bool controller = opt.h_max != d.h_max || opt.safety != d.safety || opt.fac_min != d.fac_min ||
+                          opt.fac_max != d.fac_max || opt.predictive != d.predictive ||
+                          opt.error_order != d.error_order;
+  const bool adaptive = def.info.adaptive && !gbs;
+  if (controller && !adaptive)
+    throw invalid_input(
+        "h_max, safety, fac_min, fac_max, predictive and error_order apply to the adaptive RKN and "
+        "MPE methods, not to '" +
+        def.info.name + "'");
+  if (opt.h0 != d.h0 && !adaptive && !gbs)
+    throw invalid_input("h0 (the first step) applies to adaptive methods and GBS; '" + def.info.name +
+                        "' runs with fixed steps (give h or steps)");
+  if (!std::isfinite(opt.h0) || opt.h0 < 0) throw invalid_input("h0 must be finite and >= 0");
+}
+
 /// The run of solve_impl with the method's engine, into sol.
 template <class V, class F, class VE>
 void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
@@ -721,24 +746,32 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
     if (!gbs) throw invalid_input(velocity_refusal(def.info.name));
     check_tolerances(def, opt);
     Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
-    run_gbs<VE>(run, sol, events, resume);
+    run_gbs<VE>(run, def, sol, events, resume);
   } else if (gbs || def.info.adaptive) {
     check_tolerances(def, opt);
     Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
     if (gbs) {
-      run_gbs<VE>(run, sol, events, resume);
+      run_gbs<VE>(run, def, sol, events, resume);
     } else {
-      AdaptiveOptions ao = opt.adaptive;
+      AdaptiveOptions ao;
       ao.tol = opt.rtol;
       ao.atol = opt.atol;
       ao.max_steps = opt.max_steps;
+      ao.h0 = opt.h0;
+      ao.h_max = opt.h_max;
+      ao.safety = opt.safety;
+      ao.fac_min = opt.fac_min;
+      ao.fac_max = opt.fac_max;
+      ao.predictive = opt.predictive;
+      ao.error_order = opt.error_order;
       long calls = 0;
       using Counted = CountingForce<typename Run<V, F, VE>::Force>;
       if (std::holds_alternative<MpeDef>(def.build())) {
-        auto engine = make_adaptive_mpe_integrator<VE>(def, Counted{&calls, run.force()}, ao, opt.engine);
+        auto engine =
+            make_adaptive_mpe_integrator<VE>(def, Counted{&calls, run.force()}, ao, detail::engine_options(opt));
         run_adaptive<VE>(run, engine, calls, "adaptive-mpe", def, sol, events, resume);
       } else {
-        auto engine = make_adaptive_integrator<VE>(def, Counted{&calls, run.force()}, ao, opt.engine);
+        auto engine = make_adaptive_integrator<VE>(def, Counted{&calls, run.force()}, ao, detail::engine_options(opt));
         run_adaptive<VE>(run, engine, calls, "adaptive-rkn", def, sol, events, resume);
       }
     }
@@ -804,8 +837,9 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
     return sol;
   }
   using VE = typename extended<V, td>::type;
-  const bool gbs = def.info.name == "GBS" || def.info.family == "extrapolation";
+  const bool gbs = def.info.family == "extrapolation";
   try {
+    check_step_control(def, opt, gbs);
     run_method<V, F, VE>(prob, def, opt, events, sol, dir, resume, gbs);
   } catch (const invalid_input&) {
     throw;

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "nystrom/core/state.hpp"
-#include "nystrom/engines/options.hpp"
 
 namespace nystrom {
 
@@ -31,12 +30,29 @@ struct SolveOptions {
   bool dense = false;
   /// The largest number of steps (accepted and rejected).
   long max_steps = 10000000;
-  /// Engine options (compensated summation, MPE schedule, keep_complex).
-  EngineOptions engine{};
-  /// Adaptive RKN and MPE controller (tol and max_steps are taken from above).
-  AdaptiveOptions adaptive{};
-  /// GBS (rtol, atol and max_steps are taken from above).
-  GbsOptions gbs{};
+  /// Step control of the adaptive RKN and MPE methods and of GBS. The first step (0: automatic; Hairer's
+  /// starting step for the adaptive methods, the whole span for GBS).
+  double h0 = 0;
+  /// Adaptive RKN and MPE methods only (solve() refuses them for GBS and fixed steps when not at these
+  /// defaults): the largest step (0: the span); the safety factor on the optimal step, in (0, 1]; the
+  /// smallest and largest step ratio per step; Gustafsson's predictive step ratio as well; the order p of
+  /// the error estimate (0: from the method).
+  double h_max = 0;
+  double safety = 0.9;
+  double fac_min = 0.2;
+  double fac_max = 4.0;
+  bool predictive = true;
+  int error_order = 0;
+  /// Complex-coefficient methods: keep the complexified state instead of dropping the imaginary parts
+  /// after every step (the default drops them, as in the Gurkan paper).
+  bool keep_complex = false;
+  /// Compensated summation of the updates q += dq, v += dv (automatic: on for float and double, off for
+  /// wider types).
+  Compensation compensated = Compensation::automatic;
+  /// Multi-product methods: how the products of a step are scheduled (bitwise the same results; see
+  /// EngineOptions in core/state.hpp), and the threads of the concurrent schedule (0: OpenMP's default).
+  MpeSchedule mpe_schedule = MpeSchedule::automatic;
+  int mpe_threads = 0;
   /// Take a checkpoint at the first step boundary at or after this time (NaN: none); the run goes on
   /// unchanged. Solution::checkpoint holds it; checkpoint_problem is stored in it.
   double checkpoint_at = std::numeric_limits<double>::quiet_NaN();
@@ -58,3 +74,17 @@ struct SolveOptions {
 };
 
 }  // namespace nystrom
+
+namespace nystrom::detail {
+
+/// The engines' options that SolveOptions carries.
+inline EngineOptions engine_options(const SolveOptions& o) {
+  EngineOptions e;
+  e.keep_complex = o.keep_complex;
+  e.compensated = o.compensated;
+  e.mpe_schedule = o.mpe_schedule;
+  e.mpe_threads = o.mpe_threads;
+  return e;
+}
+
+}  // namespace nystrom::detail
