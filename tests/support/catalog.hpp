@@ -1,5 +1,5 @@
 // The catalog as test parameters: the names of its entries for INSTANTIATE_TEST_SUITE_P, an entry by name,
-// and GoogleTest parameter names made of them.
+// GoogleTest parameter names made of them; and a method outside the catalog that tests of precision share.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -33,6 +33,20 @@ inline std::string param_name(const testing::TestParamInfo<std::string>& info) {
   std::string s;
   for (char c : info.param) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
   return s + "_" + std::to_string(info.index);
+}
+
+/// An RKN tableau printed with 16 digits, which cannot be refined: Nystrom's fourth-order method (the catalog's
+/// N4) with its weights rounded to 16 decimals, named N4-decimal (published_digits 16).
+inline MethodDef decimal_n4() {
+  MethodDef n4 = resolve_method("N4");
+  n4.info.name = "N4-decimal";
+  n4.info.published_digits = 16;
+  n4.build = [] {
+    return MethodData{tableau({"0", "0.5", "1"}, {{}, {"0.125"}, {"0", "0.5"}},
+                              {"0.1666666666666667", "0.3333333333333333", "0"},
+                              {"0.1666666666666667", "0.6666666666666667", "0.1666666666666667"})};
+  };
+  return n4;
 }
 
 }  // namespace nystrom::test
