@@ -19,6 +19,9 @@
 
 #include "cli.hpp"
 #include "experiments/peers.hpp"
+#include "output_file.hpp"
+#include "plot.hpp"
+#include "progress.hpp"
 
 namespace {
 

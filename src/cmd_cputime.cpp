@@ -8,6 +8,8 @@
 
 #include "cli.hpp"
 #include "experiments/localerr.hpp"
+#include "output_file.hpp"
+#include "progress.hpp"
 
 namespace {
 

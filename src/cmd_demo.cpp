@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "cli.hpp"
+#include "output_file.hpp"
 #include "sweep.hpp"
 
 namespace {

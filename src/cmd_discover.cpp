@@ -22,6 +22,8 @@
 #include "experiments/discover.hpp"
 #include "nystrom/analysis/method_file.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "output_file.hpp"
+#include "progress.hpp"
 
 namespace {
 

@@ -33,10 +33,8 @@ struct Options {
 };
 
 std::vector<double> parse_list(const std::string& text, const std::string& what) {
-  std::vector<double> v;
-  if (text.empty()) return v;
-  for (const auto& item : nystrom::cli::split_list(text, what)) v.push_back(nystrom::cli::parse_double(item, what));
-  return v;
+  if (text.empty()) return {};
+  return nystrom::cli::parse_double_list(text, what);
 }
 
 nlohmann::json to_json(const Options& o, const FlowResult& r) {

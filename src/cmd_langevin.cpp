@@ -19,6 +19,7 @@
 
 #include "cli.hpp"
 #include "nystrom/stochastic/potentials.hpp"
+#include "progress.hpp"
 
 namespace {
 

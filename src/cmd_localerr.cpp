@@ -9,6 +9,9 @@
 
 #include "cli.hpp"
 #include "experiments/localerr.hpp"
+#include "output_file.hpp"
+#include "plot.hpp"
+#include "progress.hpp"
 
 namespace {
 

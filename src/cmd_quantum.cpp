@@ -20,6 +20,7 @@
 #include "cli.hpp"
 #include "nystrom/quantum/solve.hpp"
 #include "nystrom/solve/checkpoint.hpp"  // fnv1a64
+#include "plot.hpp"
 #ifdef NYSTROM_HAVE_MPI
 #include "nystrom/quantum/fftw_mpi.hpp"
 #endif
@@ -146,38 +147,11 @@ std::string read_bounded(const std::string& path, const std::string& flag, std::
   return nystrom::read_input_file<UsageError>(path, flag, static_cast<std::size_t>(max_bytes));
 }
 
-/// The most bytes a file of values for `points` grid points may have: 128 per point (two numbers of 17
-/// digits and a comment fit) and 1 MiB more.
-std::uintmax_t file_bound(std::size_t points) { return 128 * static_cast<std::uintmax_t>(points) + (1u << 20); }
-
-/// The potential's values from a text file: numbers separated by white space, `#` to the end of a line a
-/// comment, one per grid point in row-major order (last axis fastest), at x_i = -L/2 + i L/n.
-/// A regular file of at most file_bound(points) bytes (nystrom::read_input_file).
-std::vector<double> read_potential_file(const std::string& path, std::size_t points) {
-  std::istringstream in(nystrom::read_input_file<UsageError>(path, "--potential-file", file_bound(points)));
-  std::vector<double> v;
-  std::string line;
-  for (long number = 1; std::getline(in, line); ++number) {
-    line = line.substr(0, line.find('#'));
-    std::istringstream words(line);
-    for (std::string w; words >> w;) {
-      if (v.size() == points)
-        throw UsageError("--potential-file '" + path + "' has more values than the " + std::to_string(points) +
-                         " grid points");
-      v.push_back(nystrom::cli::parse_double(w, "--potential-file value on line " + std::to_string(number)));
-    }
-  }
-  if (v.size() != points)
-    throw UsageError("--potential-file '" + path + "' has " + std::to_string(v.size()) + " values for " +
-                     std::to_string(points) + " grid points");
-  return v;
-}
-
 /// The initial wave function from a text file: one grid point per line in row-major order (last axis fastest,
 /// the order of --potential-file), "re im" or "re" (imaginary part 0); `#` to the end of a line a comment, blank
 /// lines skipped.
 std::vector<std::complex<double>> read_initial_file(const std::string& path, std::size_t points) {
-  std::istringstream in(read_bounded(path, "--initial-file", file_bound(points)));
+  std::istringstream in(read_bounded(path, "--initial-file", nystrom::cli::grid_file_bound(points)));
   std::vector<std::complex<double>> v;
   std::string line;
   for (long number = 1; std::getline(in, line); ++number) {
@@ -218,7 +192,7 @@ std::uint64_t fingerprint(const Options& o, std::string& failure) {
   for (const auto& [path, flag] : files) {
     if (path->empty()) continue;
     try {
-      text += read_bounded(*path, flag, file_bound(points));
+      text += read_bounded(*path, flag, nystrom::cli::grid_file_bound(points));
       text += '\0';
     } catch (const std::exception& e) {
       failure = e.what();
@@ -229,8 +203,7 @@ std::uint64_t fingerprint(const Options& o, std::string& failure) {
 
 /// "1" (first axis) or "1,0,-0.5" (one value per axis).
 std::vector<double> parse_vector(const std::string& text, const std::string& what, int dims) {
-  std::vector<double> v;
-  for (const auto& item : nystrom::cli::split_list(text, what)) v.push_back(nystrom::cli::parse_double(item, what));
+  const std::vector<double> v = nystrom::cli::parse_double_list(text, what);
   if (static_cast<int>(v.size()) > dims)
     throw UsageError(what + " has " + std::to_string(v.size()) + " components for " + std::to_string(dims) +
                      " dimension(s)");
@@ -266,7 +239,8 @@ QuantumResult run(const Options& o, [[maybe_unused]] const MpiSession& mpi) {
   p.potential = o.potential;
   if (!o.potential_file.empty()) {
     const Grid<R> grid(o.dims, o.grid, p.box);
-    for (double x : read_potential_file(o.potential_file, grid.size())) p.values.push_back(static_cast<R>(x));
+    for (double x : nystrom::cli::read_grid_values(o.potential_file, "--potential-file", grid.size()))
+      p.values.push_back(static_cast<R>(x));
   }
   p.g = static_cast<R>(nystrom::cli::parse_double(o.g, "--g"));
   p.time = o.imaginary ? TimeKind::imaginary : TimeKind::real;

@@ -17,6 +17,7 @@
 #include <fmt/core.h>
 
 #include "cli.hpp"
+#include "output_file.hpp"
 #include "reproduce.hpp"
 
 namespace nystrom::cli::reproduce {

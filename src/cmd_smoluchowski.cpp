@@ -14,6 +14,7 @@
 
 #include "cli.hpp"
 #include "nystrom/quantum/smoluchowski.hpp"
+#include "output_file.hpp"
 
 namespace {
 
@@ -37,26 +38,6 @@ struct Options {
   bool json = false;
 };
 
-/// Numbers separated by white space, `#` to the end of a line a comment, exactly `points` of them (one per grid
-/// point, row-major, last axis fastest); a regular file of at most 128 bytes per point and 1 MiB more.
-std::vector<double> read_grid_values(const std::string& path, const std::string& flag, std::size_t points) {
-  std::istringstream in(nystrom::read_input_file<UsageError>(path, flag, 128 * points + (std::size_t{1} << 20)));
-  std::vector<double> v;
-  std::string line;
-  for (long number = 1; std::getline(in, line); ++number) {
-    std::istringstream words(line.substr(0, line.find('#')));
-    for (std::string w; words >> w;) {
-      if (v.size() == points)
-        throw UsageError(flag + " '" + path + "' has more values than the " + std::to_string(points) + " grid points");
-      v.push_back(nystrom::cli::parse_double(w, flag + " value on line " + std::to_string(number)));
-    }
-  }
-  if (v.size() != points)
-    throw UsageError(flag + " '" + path + "' has " + std::to_string(v.size()) + " values for " +
-                     std::to_string(points) + " grid points");
-  return v;
-}
-
 SmoluchowskiResult run(const Options& o) {
   SmoluchowskiProblem<double> p;
   p.dims = o.dims;
@@ -66,15 +47,14 @@ SmoluchowskiResult run(const Options& o) {
   p.beta = nystrom::cli::parse_double(o.beta, "--beta", Bound::positive);
   p.diffusion = nystrom::cli::parse_double(o.diffusion, "--diffusion", Bound::positive);
   const Grid<double> grid(o.dims, o.grid, p.box);
-  if (!o.potential_file.empty()) p.values = read_grid_values(o.potential_file, "--potential-file", grid.size());
+  if (!o.potential_file.empty())
+    p.values = nystrom::cli::read_grid_values(o.potential_file, "--potential-file", grid.size());
   if (!o.initial_file.empty()) {
     if (!o.x0.empty() || !o.width.empty())
       throw UsageError("--initial-file replaces the Gaussian: give no --x0 or --width with it");
-    p.initial = read_grid_values(o.initial_file, "--initial-file", grid.size());
+    p.initial = nystrom::cli::read_grid_values(o.initial_file, "--initial-file", grid.size());
   } else {
-    if (!o.x0.empty())
-      for (const auto& item : nystrom::cli::split_list(o.x0, "--x0"))
-        p.x0.push_back(nystrom::cli::parse_double(item, "--x0"));
+    if (!o.x0.empty()) p.x0 = nystrom::cli::parse_double_list(o.x0, "--x0");
     if (!o.width.empty()) p.width = nystrom::cli::parse_double(o.width, "--width", Bound::positive);
   }
   p.rates = o.rates;

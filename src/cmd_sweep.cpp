@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "output_file.hpp"
 #include "sweep.hpp"
 
 namespace {

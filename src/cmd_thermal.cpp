@@ -38,26 +38,6 @@ std::vector<long> parse_longs(const std::string& text, const std::string& what) 
   return v;
 }
 
-std::vector<double> read_values(const std::string& path, std::size_t points) {
-  std::istringstream in(
-      nystrom::read_input_file<UsageError>(path, "--potential-file", 128 * points + (std::size_t{1} << 20)));
-  std::vector<double> v;
-  std::string line;
-  for (long number = 1; std::getline(in, line); ++number) {
-    std::istringstream words(line.substr(0, line.find('#')));
-    for (std::string w; words >> w;) {
-      if (v.size() == points)
-        throw UsageError("--potential-file '" + path + "' has more values than the " + std::to_string(points) +
-                         " grid points");
-      v.push_back(nystrom::cli::parse_double(w, "--potential-file value on line " + std::to_string(number)));
-    }
-  }
-  if (v.size() != points)
-    throw UsageError("--potential-file '" + path + "' has " + std::to_string(v.size()) + " values for " +
-                     std::to_string(points) + " grid points");
-  return v;
-}
-
 nystrom::cli::Registrar reg(
     "thermal", "Partition function and energy from extrapolated path-integral propagators on a grid",
     [](CLI::App& app) {
@@ -85,7 +65,9 @@ nystrom::cli::Registrar reg(
         p.potential = o->potential;
         p.beads = parse_longs(o->beads, "--beads");
         p.extrapolate = parse_longs(o->extrapolate, "--extrapolate");
-        if (!o->potential_file.empty()) p.values = read_values(o->potential_file, static_cast<std::size_t>(o->grid));
+        if (!o->potential_file.empty())
+          p.values =
+              nystrom::cli::read_grid_values(o->potential_file, "--potential-file", static_cast<std::size_t>(o->grid));
         const ThermalResult r = thermal(p);
         if (o->json) {
           nlohmann::json j;

@@ -8,6 +8,7 @@
 
 #include "cli.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "progress.hpp"
 
 namespace nystrom::cli::reproduce {
 

@@ -17,6 +17,8 @@
 #include "cli.hpp"
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "output_file.hpp"
+#include "plot.hpp"
 #include "reproduce.hpp"
 
 namespace nystrom::cli::reproduce {

@@ -14,6 +14,9 @@
 
 #include "cli.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "output_file.hpp"
+#include "plot.hpp"
+#include "progress.hpp"
 #include "reproduce.hpp"
 
 namespace nystrom::cli::reproduce {

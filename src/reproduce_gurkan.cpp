@@ -16,6 +16,9 @@
 
 #include "cli.hpp"
 #include "experiments/localerr.hpp"
+#include "output_file.hpp"
+#include "plot.hpp"
+#include "progress.hpp"
 #include "reproduce.hpp"
 
 namespace nystrom::cli::reproduce {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "nystrom/methods/method.hpp"
+#include "progress.hpp"
 
 namespace nystrom::cli {
 
@@ -30,8 +31,6 @@ struct RunRequest {
   long steps = 100;         // nbody: number of steps
   bool progress = false;    // a progress line on a terminal (RunMeter) for a long fixed-step Kepler/harmonic run
 };
-
-class Progress;
 
 /// The progress of one run, measured in force evaluations: MeteredForce calls tick() every interval()
 /// evaluations, which reads the clock and, once the run has lasted a second, draws the progress line

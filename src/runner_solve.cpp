@@ -21,37 +21,15 @@ namespace {
 
 using V2 = std::array<double, 2>;
 
-double parse_number(const std::string& text, const std::string& what) {
-  std::size_t pos = 0;
-  double x = 0;
-  try {
-    x = std::stod(text, &pos);
-  } catch (const std::exception&) {
-    pos = 0;
-  }
-  if (pos == 0 || pos != text.size() || !std::isfinite(x))
-    throw UsageError(what + ": '" + text + "' is not a finite number");
-  return x;
-}
-
 // "A:B:N" -> N equally spaced times from A to B.
 std::vector<double> parse_output_times(const std::string& spec) {
   const auto a = spec.find(':');
   const auto b = a == std::string::npos ? a : spec.find(':', a + 1);
   if (b == std::string::npos || spec.find(':', b + 1) != std::string::npos)
     throw UsageError("--output-times must be A:B:N (from A to B, N points)");
-  const double t0 = parse_number(spec.substr(0, a), "--output-times");
-  const double t1 = parse_number(spec.substr(a + 1, b - a - 1), "--output-times");
-  const std::string ns = spec.substr(b + 1);
-  long n = 0;
-  std::size_t pos = 0;
-  try {
-    n = std::stol(ns, &pos);
-  } catch (const std::exception&) {
-    pos = 0;
-  }
-  if (pos == 0 || pos != ns.size() || n < 1 || n > 10000000)
-    throw UsageError("--output-times: N must be an integer between 1 and 10000000");
+  const double t0 = parse_double(spec.substr(0, a), "--output-times A");
+  const double t1 = parse_double(spec.substr(a + 1, b - a - 1), "--output-times B");
+  const long n = static_cast<long>(parse_integer(spec.substr(b + 1), "--output-times N", 1, 10000000));
   if (n == 1 && t0 != t1) throw UsageError("--output-times: one point needs A = B");
   if (t1 < t0) throw UsageError("--output-times: B must not be before A");
   std::vector<double> t(static_cast<std::size_t>(n));

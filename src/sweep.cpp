@@ -8,6 +8,8 @@
 
 #include "cli.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "plot.hpp"
+#include "progress.hpp"
 
 namespace nystrom::cli {
 

@@ -17,44 +17,22 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/cli_runner.hpp"
+#include "support/gurkan.hpp"
+
 namespace {
 
-struct Out {
-  int code = -1;
-  std::string out, err;
-};
+/// A folder of the running test's own, which also holds the tool's captured output (cli_runner.hpp).
+std::filesystem::path scratch() { return cli_test::temp_dir(); }
 
-std::filesystem::path scratch() {
-  auto d = std::filesystem::temp_directory_path() / ("nystrom-bchcli-" + std::to_string(::getpid()) + "-" +
-                                                     ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::filesystem::create_directories(d);
-  return d;
-}
+using cli_test::slurp;
 
-std::string read_all(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-Out nystrom(const std::string& args) {
-  const char* bin = std::getenv("NYSTROM_BIN");
-  const auto d = scratch();
-  const std::string cmd = std::string(bin ? bin : "nystrom") + " " + args + " >" + (d / "o").string() + " 2>" +
-                          (d / "e").string() + " </dev/null";
-  const int st = std::system(cmd.c_str());
-  Out r;
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  r.out = read_all(d / "o");
-  r.err = read_all(d / "e");
-  return r;
-}
+cli_test::Result run_tool(const std::string& args) { return cli_test::run(args); }
 
 }  // namespace
 
 TEST(BchCli, JsonReportsOrderAndLeadingTerms) {
-  const auto r = nystrom("bch --method BR1 --json");
+  const auto r = run_tool("bch --method BR1 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["method"], "BR1");
@@ -71,7 +49,7 @@ TEST(BchCli, JsonReportsOrderAndLeadingTerms) {
 }
 
 TEST(BchCli, ExactRationalsForVerlet) {
-  const auto r = nystrom("bch --method VV --degree 3 --json");
+  const auto r = run_tool("bch --method VV --degree 3 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["exact"].get<bool>());
@@ -81,15 +59,15 @@ TEST(BchCli, ExactRationalsForVerlet) {
 }
 
 TEST(BchCli, TextOutputAndGurkanTable) {
-  const auto r = nystrom("bch --method AC1");
+  const auto r = run_tool("bch --method AC1");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("order: 5 (declared 5: confirmed)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("X11"), std::string::npos);
   // The norm of the leading error terms: Gurkan Table 4.3 prints 1.02e-5 for AC1 (three digits; the
   // whole table is compared at its printed precision in GurkanTableHasEveryPrintedDigit below).
-  const auto j = nlohmann::json::parse(nystrom("bch --method AC1 --json").out);
+  const auto j = nlohmann::json::parse(run_tool("bch --method AC1 --json").out);
   EXPECT_NEAR(j["leading"]["norm"].get<double>(), 1.02e-5, 0.005e-5);
-  const auto t = nystrom("bch --gurkan-table");
+  const auto t = run_tool("bch --gurkan-table");
   ASSERT_EQ(t.code, 0) << t.err;
   EXPECT_NE(t.out.find("AR1"), std::string::npos) << t.out;
 }
@@ -97,21 +75,7 @@ TEST(BchCli, TextOutputAndGurkanTable) {
 TEST(BchCli, GurkanTableHasEveryPrintedDigit) {
   // Gürkan, Table 4.3 (coefficients of H - Z in degree 6 and their norm), as printed in the paper: two significant
   // digits for X11, X16, X17, X19, X20 (purely imaginary for the complex methods) and three for the norm.
-  struct Printed {
-    std::string name;
-    std::vector<double> x;
-    double norm;
-    bool imaginary;
-  };
-  const std::vector<Printed> table{{"AR1", {-3.1e-3, 4.5e-4, 5.6e-3, 1.8e-5, -6.3e-5}, 6.44e-3, false},
-                                   {"AR2", {5.0e-3, -3.1e-4, -5.7e-3, 1.5e-5, 2.5e-4}, 7.58e-3, false},
-                                   {"BR1", {1.5e-4, 6.2e-5, -4.1e-4, 5.7e-5, 1.6e-4}, 4.71e-4, false},
-                                   {"BR2", {-7.0e-5, 9.7e-4, 2.7e-4, 5.2e-4, 5.2e-4}, 1.25e-3, false},
-                                   {"BR3", {3.5e-2, 1.9e-4, -3.5e-2, -3.0e-5, -1.0e-4}, 4.90e-2, false},
-                                   {"AC1", {-2.5e-6, 7.3e-6, -5.0e-6, 8.3e-7, 4.2e-6}, 1.02e-5, true},
-                                   {"AC2", {3.0e-6, -7.9e-6, 6.0e-6, -9.4e-7, -4.7e-6}, 1.15e-5, true},
-                                   {"BC1", {1.2e-5, -1.3e-5, 8.4e-6, 2.2e-7, -4.2e-6}, 1.96e-5, true},
-                                   {"BC2", {-4.1e-5, 4.9e-5, -1.2e-4, 7.7e-6, 5.0e-5}, 1.49e-4, true}};
+  const auto& table = nystrom::test::printed_gurkan_table_4_3();
   // The table shows 3 significant digits for the terms and 4 for the norm, themselves rounded, so "agrees with the
   // paper's `digits` digits" means: within half a unit of the paper's last digit plus half a unit of the shown last
   // digit (the exact rounding of the full values is asserted in test_bch, ReproducesGurkanTable43).
@@ -120,7 +84,7 @@ TEST(BchCli, GurkanTableHasEveryPrintedDigit) {
     return std::abs(shown - printed) <=
            0.5 * unit(printed, digits) + 0.5 * unit(shown, shown_digits) + 1e-12 * std::abs(printed);
   };
-  const auto r = nystrom("bch --gurkan-table");
+  const auto r = run_tool("bch --gurkan-table");
   ASSERT_EQ(r.code, 0) << r.err;
   std::istringstream lines(r.out);
   std::map<std::string, std::vector<std::string>> rows;
@@ -149,8 +113,8 @@ TEST(BchCli, GurkanTableHasEveryPrintedDigit) {
 
 TEST(BchCli, DiscoverWritesMethodsThatRun) {
   const auto dir = scratch() / "found";
-  const auto r = nystrom("discover --scheme A --starts 120 --seed 2 --threads 2 --show imaginary --write " +
-                         dir.string() + " --json");
+  const auto r = run_tool("discover --scheme A --starts 120 --seed 2 --threads 2 --show imaginary --write " +
+                          dir.string() + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.size(), 1u);
@@ -162,20 +126,20 @@ TEST(BchCli, DiscoverWritesMethodsThatRun) {
     EXPECT_GE(m["digits"].get<int>(), 30);
   }
   for (const auto& e : std::filesystem::directory_iterator(dir))
-    if (read_all(e.path()).find("equals AC1") != std::string::npos) ac1_file = e.path().string();
+    if (slurp(e.path()).find("equals AC1") != std::string::npos) ac1_file = e.path().string();
   ASSERT_FALSE(ac1_file.empty()) << "no written method file matches AC1";
-  const auto run = nystrom("run --method file:" + ac1_file + " --ecc 0.2 --steps-per-period 200 --periods 2 --json");
+  const auto run = run_tool("run --method file:" + ac1_file + " --ecc 0.2 --steps-per-period 200 --periods 2 --json");
   ASSERT_EQ(run.code, 0) << run.err;
   const auto jr = nlohmann::json::parse(run.out);
   EXPECT_LT(jr["position_error"].get<double>(), 1e-9) << run.out;
-  const auto b = nystrom("bch --method file:" + ac1_file + " --json");
+  const auto b = run_tool("bch --method file:" + ac1_file + " --json");
   ASSERT_EQ(b.code, 0) << b.err;
   // AC1's error norm as Gurkan Table 4.3 prints it (three digits)
   EXPECT_NEAR(nlohmann::json::parse(b.out)["leading"]["norm"].get<double>(), 1.02e-5, 0.005e-5);
 }
 
 TEST(BchCli, SixStageFromPublishedMethod) {
-  const auto r = nystrom("discover --six-stage --from AC1 --tries 4 --seed 5 --six-bits 0 --json");
+  const auto r = run_tool("discover --six-stage --from AC1 --tries 4 --seed 5 --six-bits 0 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_NEAR(j["published_error_norm"].get<double>(), 2.6e-7, 0.05e-7);
@@ -206,7 +170,7 @@ TEST(BchCli, BadInputIsOneLineAndExitCode2) {
         "run --method file:" + noname.string(), "run --method file:" + garbage.string(),
         "bch --method file:" + bad.string(), "run --method file:" + scratch().string(),
         std::string("run --method file:/nonexistent/x.txt")}) {
-    const auto r = nystrom(args);
+    const auto r = run_tool(args);
     EXPECT_EQ(r.code, 2) << args << "\n" << r.out << r.err;
     EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;

@@ -20,23 +20,14 @@
 #include <nlohmann/json.hpp>
 
 #include "nystrom/methods/catalog.hpp"
+#include "support/cli_runner.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using cli_test::slurp;
+using cli_test::tool;
 using nlohmann::json;
-
-std::string tool() {
-  const char* b = std::getenv("NYSTROM_BIN");
-  return b ? b : "nystrom";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 int shell(const std::string& cmd) {
   const int status = std::system(cmd.c_str());

@@ -20,9 +20,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_runner.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/problems/reference.hpp"
+#include "support/cli_runner.hpp"
 
 namespace {
 

@@ -26,8 +26,8 @@
 #include <thread>
 #include <vector>
 
-#include "checksum.hpp"
-#include "cli_runner.hpp"
+#include "support/checksum.hpp"
+#include "support/cli_runner.hpp"
 
 extern char** environ;
 
@@ -566,7 +566,7 @@ TEST(CliHostile, InputFilesThatAreNotRegularFilesAreRefusedAtOnce) {
 
 namespace {
 
-// The checkpoint with its checksum line recomputed (tests/checksum.hpp, independently of the tool).
+// The checkpoint with its checksum line recomputed (tests/support/checksum.hpp, independently of the tool).
 std::string rechecksum(const std::string& text) { return nystrom::test::with_checksum(nystrom::test::body_of(text)); }
 
 std::string replace_line(const std::string& text, const std::string& key, const std::string& line) {

@@ -19,7 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_runner.hpp"
+#include "support/cli_runner.hpp"
 
 #include "nystrom/problems/kepler.hpp"
 

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_runner.hpp"
+#include "support/cli_runner.hpp"
 
 using namespace cli_test;
 

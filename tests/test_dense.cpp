@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "kepler_solve.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/solve/solve.hpp"
+#include "support/kepler.hpp"
 
 using namespace nystrom;
 using nystrom::test::kepler;

@@ -26,13 +26,15 @@
 #include <thread>
 #include <vector>
 
-#include "checksum.hpp"
-#include "kepler_solve.hpp"
 #include "nystrom/core/files.hpp"
 #include "nystrom/solve.hpp"
+#include "support/checksum.hpp"
+#include "support/files.hpp"
+#include "support/kepler.hpp"
 
 using namespace nystrom;
 using nystrom::test::kepler;
+using nystrom::test::slurp;
 namespace fs = std::filesystem;
 
 namespace {
@@ -43,13 +45,6 @@ fs::path fresh_dir() {
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 std::set<std::string> listing(const fs::path& dir) {

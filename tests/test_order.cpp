@@ -57,8 +57,12 @@
 #include "experiments/kepler.hpp"
 #include "nystrom/methods/refine.hpp"
 #include "nystrom/nystrom.hpp"
+#include "support/catalog.hpp"
 
 using namespace nystrom;
+using test::catalog_names;
+using test::find_in_catalog;
+using test::param_name;
 
 namespace {
 
@@ -208,25 +212,6 @@ bool order_matches(int declared, double observed, bool complex_method) {
   return std::abs(observed - declared) < kOrderTolerance;
 }
 
-std::vector<std::string> catalog_names() {
-  std::vector<std::string> names;
-  for (const auto& d : catalog()) names.push_back(d.info.name);
-  return names;
-}
-
-const MethodDef& find_in_catalog(const std::string& name) {
-  for (const auto& d : catalog())
-    if (d.info.name == name) return d;
-  throw std::invalid_argument("no catalog entry '" + name + "'");
-}
-
-/// GoogleTest parameter names allow only [A-Za-z0-9_]; the index keeps them unique.
-std::string test_name(const testing::TestParamInfo<std::string>& info) {
-  std::string s;
-  for (char c : info.param) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return s + "_" + std::to_string(info.index);
-}
-
 class ObservedOrder : public testing::TestWithParam<std::string> {};
 
 }  // namespace
@@ -251,7 +236,7 @@ TEST_P(ObservedOrder, MatchesDeclaredOrder) {
       << m.log();
 }
 
-INSTANTIATE_TEST_SUITE_P(Catalog, ObservedOrder, testing::ValuesIn(catalog_names()), test_name);
+INSTANTIATE_TEST_SUITE_P(Catalog, ObservedOrder, testing::ValuesIn(catalog_names()), param_name);
 
 // Specifications outside the catalog list: multi-product sequences on velocity Verlet (the catalog's
 // M<2n> run on position Verlet) and a sequence that is not the natural one. Order 2n for n products.
@@ -450,4 +435,4 @@ TEST_P(ToleranceProportionality, ErrorFollowsTheTolerance) {
   EXPECT_GT(tight.force_evals, loose.force_evals);
 }
 
-INSTANTIATE_TEST_SUITE_P(Adaptive, ToleranceProportionality, testing::ValuesIn(adaptive_names()), test_name);
+INSTANTIATE_TEST_SUITE_P(Adaptive, ToleranceProportionality, testing::ValuesIn(adaptive_names()), param_name);

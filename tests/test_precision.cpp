@@ -15,6 +15,7 @@
 
 #include "experiments/kepler.hpp"
 #include "nystrom/nystrom.hpp"
+#include "support/catalog.hpp"
 
 using namespace nystrom;
 
@@ -399,14 +400,7 @@ TEST(Precision, RefinedCoefficientsRemoveThePublishedDigitsFloor) {
 // Asking for a precision that a method's coefficients cannot reach, and cannot be refined to, is a
 // clear error (here: an RKN tableau printed with 16 digits).
 TEST(Precision, PrecisionBeyondUnrefinableCoefficientsIsAClearError) {
-  MethodDef n4 = resolve_method("N4");
-  n4.info.name = "N4-decimal";
-  n4.info.published_digits = 16;
-  n4.build = [] {
-    return MethodData{tableau({"0", "0.5", "1"}, {{}, {"0.125"}, {"0", "0.5"}},
-                              {"0.1666666666666667", "0.3333333333333333", "0"},
-                              {"0.1666666666666667", "0.6666666666666667", "0.1666666666666667"})};
-  };
+  const MethodDef n4 = test::decimal_n4();
   EXPECT_NO_THROW(run_kepler<double>(n4, 0.5, 100, 1));
   for_each_extended([&](auto tag, const std::string& name) {
     using T = typename decltype(tag)::type;

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "nystrom/nystrom.hpp"
+#include "support/catalog.hpp"
 
 // ---- a forward-mode dual number --------------------------------------------------------------------
 
@@ -140,28 +141,13 @@ struct scalar_traits<DualQd4> {
 }  // namespace nystrom
 
 using namespace nystrom;
+using test::catalog_names;
+using test::find_in_catalog;
+using test::param_name;
 
 namespace {
 
 constexpr long double kEps = std::numeric_limits<long double>::epsilon();  // 2^-63
-
-std::vector<std::string> catalog_names() {
-  std::vector<std::string> names;
-  for (const auto& d : catalog()) names.push_back(d.info.name);
-  return names;
-}
-
-const MethodDef& find_in_catalog(const std::string& name) {
-  for (const auto& d : catalog())
-    if (d.info.name == name) return d;
-  throw std::invalid_argument("no catalog entry '" + name + "'");
-}
-
-std::string test_name(const testing::TestParamInfo<std::string>& info) {
-  std::string s;
-  for (char c : info.param) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return s + "_" + std::to_string(info.index);
-}
 
 /// A generic point of the e = 0.5 orbit (neither apocentre nor pericentre), in long double.
 State<std::array<long double, 2>> start_state() { return KeplerProblem<long double>(0.5L).exact(1.0L); }
@@ -226,7 +212,7 @@ TEST_P(Symmetry, DeclaredSymmetricMethodsRetraceTheirSteps) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Catalog, Symmetry, testing::ValuesIn(catalog_names()), test_name);
+INSTANTIATE_TEST_SUITE_P(Catalog, Symmetry, testing::ValuesIn(catalog_names()), param_name);
 
 TEST(SymmetryControl, NonSymmetricMethodsDoNotRetrace) {
   // The task's named controls: Nystrom 4 and Albrecht 6, and M4 (a sum of symmetric products).
@@ -366,7 +352,7 @@ TEST_P(Symplecticity, DeclaredSymplecticMethodsPreserveTheSymplecticForm) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Catalog, Symplecticity, testing::ValuesIn(catalog_names()), test_name);
+INSTANTIATE_TEST_SUITE_P(Catalog, Symplecticity, testing::ValuesIn(catalog_names()), param_name);
 
 TEST(SymplecticityControl, NonSymplecticRknMethodsFail) {
   for (const char* name : {"N4", "M4", "M4-RKN", "A6"}) {
@@ -571,4 +557,4 @@ TEST_P(DefectOrder, SymplecticDefectIsRoundingOrHasThePredictedOrder) {
                            def.info.name + flag + ", Henon-Heiles, h = 1/16, 1/32, 1/64");
 }
 
-INSTANTIATE_TEST_SUITE_P(Catalog, DefectOrder, testing::ValuesIn(catalog_names()), test_name);
+INSTANTIATE_TEST_SUITE_P(Catalog, DefectOrder, testing::ValuesIn(catalog_names()), param_name);

@@ -13,6 +13,7 @@
 #include "nystrom/analysis/rkn_order_conditions.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/refine.hpp"
+#include "support/catalog.hpp"
 
 using namespace nystrom;
 
@@ -202,14 +203,7 @@ TEST(Refine, TableThatMissesItsConditionsIsRefused) {
 // Decimal tables that are not splittings cannot be refined: asking for more precision than their
 // digits is an error, not silently rounded coefficients.
 TEST(Refine, DecimalRknTableauBeyondItsDigitsIsRefused) {
-  MethodDef n4 = resolve_method("N4");
-  n4.info.name = "N4-decimal";
-  n4.info.published_digits = 16;
-  n4.build = [] {
-    return MethodData{tableau({"0", "0.5", "1"}, {{}, {"0.125"}, {"0", "0.5"}},
-                              {"0.1666666666666667", "0.3333333333333333", "0"},
-                              {"0.1666666666666667", "0.6666666666666667", "0.1666666666666667"})};
-  };
+  const MethodDef n4 = test::decimal_n4();
   EXPECT_NO_THROW(method_data_for(n4, 53, "double"));
   try {
     method_data_for(n4, 113, "float128");

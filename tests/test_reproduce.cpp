@@ -26,7 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_runner.hpp"
+#include "support/cli_runner.hpp"
 
 namespace {
 

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "kepler_solve.hpp"
 #include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/solve/solve.hpp"
+#include "support/kepler.hpp"
 
 using namespace nystrom;
 using nystrom::test::kepler;

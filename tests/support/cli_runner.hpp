@@ -10,9 +10,9 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
+
+#include "support/files.hpp"
 
 namespace cli_test {
 
@@ -26,12 +26,7 @@ inline std::string tool() {
   return b ? b : "nystrom";
 }
 
-inline std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using nystrom::test::slurp;
 
 /// A folder of its own for the running test (process id and test name).
 inline std::filesystem::path temp_dir() {
