@@ -10,12 +10,12 @@
 // API (the same as engines/adaptive_rkn.hpp; AdaptiveOptions, AdaptiveStats and the exceptions of
 // engines/step_control.hpp):
 //
-//   nystrom::AdaptiveOptions opt;  opt.tol = 1e-12;
+//   nystrom::AdaptiveOptions opt;  opt.rtol = 1e-12;
 //   auto ai = nystrom::make_adaptive_mpe_integrator<V>(def, force, opt);  // def: an MPE method (MpeDef)
 //   nystrom::AdaptiveStats st = ai.integrate_to(state, t0, t1 [, observer]);
 //
 // The controller is the one both adaptive engines share (engines/step_control.hpp): mixed norm
-// sqrt((1/2n) sum (e_i / sc_i)^2) with sc_i = tol (1 + max(|y_i(t)|, |y_i(t+h)|)) (or atol + tol max(...) with
+// sqrt((1/2n) sum (e_i / sc_i)^2) with sc_i = rtol (1 + max(|y_i(t)|, |y_i(t+h)|)) (or atol + rtol max(...) with
 // opt.atol); accept when <= 1; h *= min(fac_max, max(fac_min, safety err^(-1/(p+1)))), p = 2n - 2, or Gustafsson's
 // predictive ratio when smaller (the default, adaptive_detail::StepController); no growth right after a rejection;
 // Hairer's starting step unless opt.h0 > 0; the last step lands exactly on t1; exact force counting (rejected steps
@@ -398,7 +398,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   int nmin_target() const { return std::min(3, nmax_); }
 
   int oc_initial_products() const {
-    const double tol = opt_.tol > 0 ? opt_.tol : opt_.atol;
+    const double tol = opt_.rtol > 0 ? opt_.rtol : opt_.atol;
     const int n = static_cast<int>(-0.6 * std::log10(tol) + 1.5);
     return std::max(nmin_target(), std::min(nmax_, n));
   }

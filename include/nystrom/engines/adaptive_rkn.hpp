@@ -3,8 +3,8 @@
 //
 // API (what the CLI calls for `nystrom run --method DP12-adaptive --tol 1e-12`):
 //
-//   nystrom::AdaptiveOptions opt;            // all fields optional except tol
-//   opt.tol = 1e-12;
+//   nystrom::AdaptiveOptions opt;            // all fields optional except rtol
+//   opt.rtol = 1e-12;
 //   auto ai = nystrom::make_adaptive_integrator<V>(def, force, opt);   // def: a MethodDef whose
 //                                            // tableau carries bhat/Bhat (info.adaptive == true)
 //   nystrom::AdaptiveStats st = ai.integrate_to(state, t0, t1);        // lands exactly on t1
@@ -13,7 +13,7 @@
 //   st.accepted, st.rejected, st.force_evals, st.last_h                 // this call; ai.total() sums all calls
 //
 // V is std::array<T, N> or std::vector<T> with a real T (double, long double, float128, ...).
-// Errors: std::invalid_argument for bad input (tol or atol negative or not finite, both zero, tol
+// Errors: std::invalid_argument for bad input (rtol or atol negative or not finite, both zero, rtol
 // below 10 eps of the scalar type, t1 < t0, t0/t1 not finite,
 // NaN/inf or inconsistent state, a tableau without embedded weights, bad options);
 // nystrom::StepSizeUnderflow (a std::runtime_error) when the step size falls below the rounding

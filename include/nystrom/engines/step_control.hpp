@@ -8,9 +8,9 @@
 //     (h^2 sum (b - bhat) f) and v (h sum (B - Bhat) f)); the higher-order solution is propagated (local
 //     extrapolation);
 //   * norm: err = sqrt( (1/2n) sum_i (e_i / sc_i)^2 ) over all n positions and n velocities, with
-//     sc_i = tol * (1 + max(|y_i(t)|, |y_i(t+h)|)): mixed absolute/relative with one tolerance
-//     (opt.atol 0 or equal to tol), or sc_i = atol + tol * max(|y_i(t)|, |y_i(t+h)|) with a separate
-//     absolute tolerance (tol 0: absolute only); ErrorScale, error_norm (error_norm2: its square with a
+//     sc_i = rtol * (1 + max(|y_i(t)|, |y_i(t+h)|)): mixed absolute/relative with one tolerance
+//     (opt.atol 0 or equal to opt.rtol), or sc_i = atol + rtol * max(|y_i(t)|, |y_i(t+h)|) with a separate
+//     absolute tolerance (rtol 0: absolute only); ErrorScale, error_norm (error_norm2: its square with a
 //     floor on the scale, for the multi-product expansion);
 //   * accept when err <= 1; new h = h * min(fac_max, max(fac_min, safety * err^(-1/(p+1)))), p the
 //     lower order of the pair, or Gustafsson's predictive ratio when smaller (opt.predictive, on by
@@ -77,16 +77,16 @@ struct NoObserver {
 };
 
 /// The scale sc of the error of a component of size y (the larger of its sizes at both ends of the
-/// step): tol (1 + y) with one tolerance (atol 0 or equal to tol), atol + tol y with two.
+/// step): rtol (1 + y) with one tolerance (atol 0 or equal to rtol), atol + rtol y with two.
 template <class R>
 class ErrorScale {
  public:
   explicit ErrorScale(const AdaptiveOptions& opt)
-      : tol_(opt.tol), atol_(opt.atol), mixed_(opt.atol == 0 || opt.atol == opt.tol) {}
-  R operator()(const R& y) const { return mixed_ ? R(tol_ * (R(1) + y)) : R(atol_ + tol_ * y); }
+      : rtol_(opt.rtol), atol_(opt.atol), mixed_(opt.atol == 0 || opt.atol == opt.rtol) {}
+  R operator()(const R& y) const { return mixed_ ? R(rtol_ * (R(1) + y)) : R(atol_ + rtol_ * y); }
 
  private:
-  R tol_, atol_;
+  R rtol_, atol_;
   bool mixed_;
 };
 
@@ -94,8 +94,8 @@ class ErrorScale {
 template <class R>
 void check_tolerance(const AdaptiveOptions& opt) {
   const double min_tol = 10 * as_double(epsilon_of<R>());
-  if (opt.tol > 0 && opt.tol < min_tol)
-    throw std::invalid_argument("tolerance " + sci(opt.tol) + " is below what " + scalar_traits<R>::name() +
+  if (opt.rtol > 0 && opt.rtol < min_tol)
+    throw std::invalid_argument("tolerance " + sci(opt.rtol) + " is below what " + scalar_traits<R>::name() +
                                 " resolves (10 eps = " + sci(min_tol) + "); use a wider precision");
 }
 

@@ -729,7 +729,7 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
       run_gbs<VE>(run, sol, events, resume);
     } else {
       AdaptiveOptions ao = opt.adaptive;
-      ao.tol = opt.rtol;
+      ao.rtol = opt.rtol;
       ao.atol = opt.atol;
       ao.max_steps = opt.max_steps;
       long calls = 0;
