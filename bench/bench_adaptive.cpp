@@ -66,7 +66,7 @@ void bm_adaptive(benchmark::State& state, const std::string& method, double ecc)
   using V = std::array<T, 2>;
   long calls = 0, forces = 0;
   AdaptiveOptions opt;
-  opt.tol = kTol;
+  opt.rtol = kTol;
   const KeplerProblem<T> prob{T(ecc)};
   const auto s0 = prob.initial_state();
   const T t1 = KeplerProblem<T>::period() * T(kPeriods);

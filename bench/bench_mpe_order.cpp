@@ -40,7 +40,7 @@ void sweep(double ecc) {
     const double tol = std::pow(10.0, -5.0 - 0.25 * it);
     for (std::size_t m = 0; m < kMethods.size(); ++m) {
       AdaptiveOptions opt;
-      opt.tol = tol;
+      opt.rtol = tol;
       const MethodDef def = resolve_method(kMethods[m]);
       double seconds = INFINITY, err = 0;
       for (int rep = 0; rep < kReps; ++rep) {

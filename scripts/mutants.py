@@ -60,8 +60,9 @@ EXCLUDED = {
 # file -> layer: the first matching prefix wins. layer -> the test programs run whole for its mutants.
 # A program is in a layer when it reaches that layer's code and builds and runs in seconds at -O0.
 FILE_LAYER = [
+    ("include/nystrom/engines/step_control.hpp", "step_control"),
     ("include/nystrom/engines/adaptive_rkn.hpp", "adaptive_rkn"),
-    ("include/nystrom/engines/adaptive_mpe.hpp", "adaptive_mpe"),
+    ("include/nystrom/engines/adaptive_mpe", "adaptive_mpe"),
     ("include/nystrom/engines/gbs.hpp", "gbs"),
     ("include/nystrom/engines/", "engines"),
     ("include/nystrom/solve/odeint.hpp", "odeint"),
@@ -78,6 +79,8 @@ FILE_LAYER = [
 ]
 LAYERS = {
     "engines": ["test_engines", "test_compensated", "test_carry", "test_engine_edges"],
+    "step_control": ["test_adaptive_rkn", "test_adaptive_mpe", "test_adaptive_cost", "test_carry",
+                     "test_solve_directions"],
     "adaptive_rkn": ["test_adaptive_rkn", "test_adaptive_cost", "test_carry", "test_solve_directions"],
     "adaptive_mpe": ["test_adaptive_mpe", "test_adaptive_cost", "test_carry", "test_solve_directions"],
     "gbs": ["test_gbs", "test_adaptive_cost", "test_engine_edges", "test_solve_directions"],
@@ -97,7 +100,7 @@ EQUIVALENT = {
     ("include/nystrom/engines/mpe.hpp", "bool lockstep_ = false, concurrent_ = false;",
      "bool lockstep_ = false, concurrent_ = true;"):
     "the only constructor assigns concurrent_ before any use: the default member initializer is never read",
-    ("include/nystrom/engines/adaptive_rkn.hpp", "hmax_ = opt.h_max > 0 ? std::min(span, R(opt.h_max)) : span;",
+    ("include/nystrom/engines/step_control.hpp", "hmax_ = opt.h_max > 0 ? std::min(span, R(opt.h_max)) : span;",
      "hmax_ = opt.h_max > 0 ? std::min(R(opt.h_max), span) : span;"):
     "std::min of two finite values (AdaptiveOptions::validate) is the same value in either order",
     ("include/nystrom/planetary/kepler_drift.hpp", "inline constexpr std::size_t kKeplerBatch = 8;",

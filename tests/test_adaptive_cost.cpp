@@ -196,12 +196,12 @@ TEST(AdaptiveCost, OrderControlSpendsNoMoreThanTheBestFixedOrder) {
 // ---- the controller's parts on known inputs -----------------------------------------------------------
 
 TEST(AdaptiveController, ErrorScaleIsMixedWithOneToleranceAndSplitWithTwo) {
-  const adaptive_detail::ErrorScale<double> one(AdaptiveOptions{.tol = 1e-6});
+  const adaptive_detail::ErrorScale<double> one(AdaptiveOptions{.rtol = 1e-6});
   EXPECT_DOUBLE_EQ(one(0.0), 1e-6);
   EXPECT_DOUBLE_EQ(one(3.0), 4e-6);
-  const adaptive_detail::ErrorScale<double> same(AdaptiveOptions{.tol = 1e-6, .atol = 1e-6});
+  const adaptive_detail::ErrorScale<double> same(AdaptiveOptions{.rtol = 1e-6, .atol = 1e-6});
   EXPECT_DOUBLE_EQ(same(3.0), 4e-6);
-  const adaptive_detail::ErrorScale<double> two(AdaptiveOptions{.tol = 1e-6, .atol = 1e-9});
+  const adaptive_detail::ErrorScale<double> two(AdaptiveOptions{.rtol = 1e-6, .atol = 1e-9});
   EXPECT_DOUBLE_EQ(two(0.0), 1e-9);
   EXPECT_DOUBLE_EQ(two(3.0), 1e-9 + 3e-6);
 }
@@ -246,7 +246,7 @@ TEST(AdaptiveController, StartingStepIsHairersOnTheOscillator) {
   // d2 = |(0.005/2e-6, 0)| / 0.005 = 2500/sqrt(2)/0.005, h1 = (0.01 / max(d1, d2))^(1/11), h = min(100 h0, h1).
   const State<std::array<double, 1>> s{{1.0}, {0.0}};
   auto force = [](const std::array<double, 1>& q, std::array<double, 1>& a) { a[0] = -q[0]; };
-  const adaptive_detail::ErrorScale<double> scale(AdaptiveOptions{.tol = 1e-6});
+  const adaptive_detail::ErrorScale<double> scale(AdaptiveOptions{.rtol = 1e-6});
   const double d1 = 1e6 / std::sqrt(2.0), d2 = 2500 / std::sqrt(2.0) / 0.005;
   const double h1 = std::pow(0.01 / std::max(d1, d2), 1.0 / 11);
   EXPECT_NEAR(adaptive_detail::hairer_initial_step(force, s, 100.0, scale, 10), std::min(0.5, h1), 1e-12);

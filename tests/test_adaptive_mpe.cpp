@@ -29,7 +29,7 @@ using CountingKepler = CountingForce<KeplerForce>;
 
 AdaptiveOptions with_tol(double tol) {
   AdaptiveOptions o;
-  o.tol = tol;
+  o.rtol = tol;
   return o;
 }
 

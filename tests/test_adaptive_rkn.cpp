@@ -40,7 +40,7 @@ struct BlowUp {
 
 AdaptiveOptions with_tol(double tol) {
   AdaptiveOptions o;
-  o.tol = tol;
+  o.rtol = tol;
   return o;
 }
 

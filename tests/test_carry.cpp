@@ -132,13 +132,13 @@ void expect_adaptive_restart(Make make) {
 
 TEST(Carry, AdaptiveRknStartsAfreshFromAMovedState) {
   const MethodDef def = resolve_method("DP12-adaptive");
-  expect_adaptive_restart([&] { return make_adaptive_integrator<V>(def, KeplerForce{}, {.tol = 1e-11}); });
+  expect_adaptive_restart([&] { return make_adaptive_integrator<V>(def, KeplerForce{}, {.rtol = 1e-11}); });
 }
 
 TEST(Carry, AdaptiveMpeStartsAfreshFromAMovedState) {
   for (const std::string m : {"M10-adaptive", "MPE-adaptive"}) {
     SCOPED_TRACE(m);
     const MethodDef def = resolve_method(m);
-    expect_adaptive_restart([&] { return make_adaptive_mpe_integrator<V>(def, KeplerForce{}, {.tol = 1e-11}); });
+    expect_adaptive_restart([&] { return make_adaptive_mpe_integrator<V>(def, KeplerForce{}, {.rtol = 1e-11}); });
   }
 }

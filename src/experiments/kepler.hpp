@@ -66,7 +66,7 @@ KeplerRunResult run_kepler_adaptive(const MethodDef& def, double ecc, double tol
   if (!std::isfinite(ecc)) throw std::invalid_argument("eccentricity is not finite");
   const KeplerProblem<T> prob(static_cast<T>(ecc));
   AdaptiveOptions opt;
-  opt.tol = tol;
+  opt.rtol = tol;
   const auto s0 = prob.initial_state();
   auto s = s0;
   const T t_end = KeplerProblem<T>::period() * T(periods);

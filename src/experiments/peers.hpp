@@ -213,7 +213,7 @@ inline MethodSpec nystrom_adaptive(const std::string& name, double ecc, long per
   m.make = [def, ecc, periods](ForceCounter* c) -> Prepare {
     return [def, ecc, periods, c](double tol) -> Run {
       AdaptiveOptions opt;
-      opt.tol = tol;
+      opt.rtol = tol;
       opt.h0 = 1e-3;
       auto proto = std::make_shared<AdaptiveRknIntegrator<Vec2, CountingKepler>>(
           make_adaptive_integrator<Vec2>(def, CountingKepler{c}, opt));
@@ -248,7 +248,7 @@ inline MethodSpec nystrom_adaptive_mpe(const std::string& name, double ecc, long
   m.make = [def, ecc, periods, compensated](ForceCounter* c) -> Prepare {
     return [def, ecc, periods, c, compensated](double tol) -> Run {
       AdaptiveOptions opt;
-      opt.tol = tol;
+      opt.rtol = tol;
       opt.h0 = 1e-3;
       EngineOptions eo;
       eo.compensated = compensated ? Compensation::on : Compensation::off;

@@ -10,8 +10,8 @@
 namespace nystrom {
 
 struct AdaptiveOptions {
-  double tol = 1e-10;         // relative tolerance, and the absolute one when atol is 0 (see the norm above)
-  double atol = 0;            // absolute tolerance; 0 (or equal to tol): the mixed norm with tol alone
+  double rtol = 1e-10;        // relative tolerance, and the absolute one when atol is 0 (engines/step_control.hpp)
+  double atol = 0;            // absolute tolerance; 0 (or equal to rtol): the mixed norm with rtol alone
   double safety = 0.9;        // safety factor on the optimal step (see below)
   double fac_min = 0.2;       // smallest step ratio per step
   double fac_max = 4.0;       // largest step ratio per step
@@ -22,10 +22,10 @@ struct AdaptiveOptions {
   bool predictive = true;     // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
 
   void validate() const {
-    if (!std::isfinite(tol) || !(tol >= 0)) throw std::invalid_argument("tolerance must be a finite number >= 0");
+    if (!std::isfinite(rtol) || !(rtol >= 0)) throw std::invalid_argument("tolerance must be a finite number >= 0");
     if (!std::isfinite(atol) || !(atol >= 0))
       throw std::invalid_argument("absolute tolerance must be a finite number >= 0");
-    if (!(tol > 0) && !(atol > 0)) throw std::invalid_argument("tolerance and absolute tolerance are both zero");
+    if (!(rtol > 0) && !(atol > 0)) throw std::invalid_argument("tolerance and absolute tolerance are both zero");
     if (!(safety > 0 && safety <= 1)) throw std::invalid_argument("safety factor must be in (0, 1]");
     if (!(fac_min > 0 && fac_min < 1)) throw std::invalid_argument("fac_min must be in (0, 1)");
     if (!(fac_max > 1 && std::isfinite(fac_max))) throw std::invalid_argument("fac_max must be a finite number > 1");

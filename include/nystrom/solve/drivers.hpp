@@ -754,7 +754,7 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
       run_gbs<VE>(run, def, sol, events, resume);
     } else {
       AdaptiveOptions ao;
-      ao.tol = opt.rtol;
+      ao.rtol = opt.rtol;
       ao.atol = opt.atol;
       ao.max_steps = opt.max_steps;
       ao.h0 = opt.h0;
