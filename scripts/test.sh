@@ -5,7 +5,7 @@
 # check); build the tool, every C++ test and the libFuzzer harnesses with clang-14 under AddressSanitizer + UBSan
 # (leak detection on), run the whole C++ suite there (the library's test programs are built only there) and each
 # harness for a fixed time; a small fixed sample of mechanically generated mutants (scripts/mutants.py).
-# NYSTROM_FUZZ_SECONDS: seconds per fuzzer (default 20).
+# NYSTROM_FUZZ_SECONDS: seconds per fuzzer (default 12).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -44,8 +44,8 @@ python3 scripts/mutants.py --seed 35 --count 3 --layers operators,planetary --li
   --build build/mutants-ci --jobs "$jobs"
 echo "   ($(( $(date +%s) - start )) s so far)"
 
-echo "== libFuzzer harnesses (ASan + UBSan), ${NYSTROM_FUZZ_SECONDS:-20} s each"
-NYSTROM_FUZZ_BUILD=build/asan-fuzz NYSTROM_FUZZ_SECONDS=${NYSTROM_FUZZ_SECONDS:-20} \
+echo "== libFuzzer harnesses (ASan + UBSan), ${NYSTROM_FUZZ_SECONDS:-12} s each"
+NYSTROM_FUZZ_BUILD=build/asan-fuzz NYSTROM_FUZZ_SECONDS=${NYSTROM_FUZZ_SECONDS:-12} \
   NYSTROM_FUZZ_HARNESSES="method_spec method_file particles checkpoint cli" bash scripts/fuzz.sh
 
 echo "== all tests passed in $(( $(date +%s) - start )) s"

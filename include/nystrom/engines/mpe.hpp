@@ -102,12 +102,17 @@ class MpeStepper {
       comp_.invalidate();
       return;
     }
-    // The base's coefficients times h / k_i, product after product.
+    // The base's coefficients times h / k_i, product after product (kept while h stays, in the built-in
+    // floating-point types: a driver that takes one step per call pays for them once).
     const std::size_t m = base_.scheme().steps.size();
-    scaled_.resize(k_.size() * m);
-    for (std::size_t i = 0; i < k_.size(); ++i) {
-      base_.scale_coefficients(h / static_cast<real_type>(k_[i]), hc_);
-      std::copy(hc_.begin(), hc_.end(), scaled_.begin() + static_cast<std::ptrdiff_t>(i * m));
+    if (!std::is_floating_point_v<real_type> || !scaled_for_h_ || !(scaled_h_ == h)) {
+      scaled_.resize(k_.size() * m);
+      for (std::size_t i = 0; i < k_.size(); ++i) {
+        base_.scale_coefficients(h / static_cast<real_type>(k_[i]), hc_);
+        std::copy(hc_.begin(), hc_.end(), scaled_.begin() + static_cast<std::ptrdiff_t>(i * m));
+      }
+      scaled_h_ = h;
+      scaled_for_h_ = true;
     }
     // A fixed-size state and carry live in locals for the loop (see SplittingStepper::run).
     constexpr bool local = is_std_array<V>::value;
@@ -429,6 +434,8 @@ class MpeStepper {
   std::vector<std::size_t> order_;                   // concurrent: products by decreasing k
   std::vector<V> pa_, pcq_, pcv_;                    // lockstep: each product's force cache and carries
   std::vector<scalar_type> scaled_, hc_;             // base coefficients times h / k_i, product after product
+  real_type scaled_h_{};                             // the h of scaled_
+  bool scaled_for_h_ = false;
   Compensator<V> comp_, pc_;
 };
 
