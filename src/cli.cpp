@@ -11,6 +11,7 @@
 
 #include <fmt/core.h>
 
+#include "reported_error.hpp"
 #include "signals.hpp"
 
 namespace nystrom::cli {
@@ -187,6 +188,9 @@ int run_main(int argc, char** argv) {
     const Invocation inv = parse_command_line(argc, argv, std::cout);
     if (inv.exit_now >= 0) return inv.exit_now;
     return inv.action();
+  } catch (const ReportedUsageError&) {
+    std::cout.flush();
+    return 2;
   } catch (const std::bad_alloc&) {
     return fail("out of memory: the request is too large for this machine");
   } catch (const std::filesystem::filesystem_error& e) {

@@ -21,6 +21,7 @@
 #include "nystrom/quantum/solve.hpp"
 #include "nystrom/solve/checkpoint.hpp"  // fnv1a64
 #include "plot.hpp"
+#include "reported_error.hpp"
 #ifdef NYSTROM_HAVE_MPI
 #include "nystrom/quantum/fftw_mpi.hpp"
 #endif
@@ -105,19 +106,34 @@ class MpiSession {
         MPI_Bcast(&n, 1, MPI_INT, first, MPI_COMM_WORLD);
         why.resize(static_cast<std::size_t>(n));
         MPI_Bcast(why.data(), n, MPI_CHAR, first, MPI_COMM_WORLD);
-        throw UsageError(first == 0 ? why : "MPI rank " + std::to_string(first) + ": " + why);
+        refuse(first == 0 ? why : "MPI rank " + std::to_string(first) + ": " + why);
       }
       unsigned long long lo = fingerprint, hi = fingerprint;
       MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_UNSIGNED_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
       MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
       if (lo != hi)
-        throw UsageError(
+        refuse(
             "the MPI ranks were given different arguments or input files: every rank must run the same command on "
             "the same files");
       return;
     }
 #endif
     if (!failure.empty()) throw UsageError(failure);
+  }
+
+  /// Every rank ends with the same refusal: rank 0 prints its one line before any rank may exit (a rank that
+  /// exited first would make the launcher stop rank 0 before it printed), then every rank exits with status 2.
+  [[noreturn]] void refuse([[maybe_unused]] const std::string& why) const {
+#ifdef NYSTROM_HAVE_MPI
+    if (rank_ == 0) {
+      const std::string line = "nystrom: error: " + why + "\n";
+      if (::write(STDERR_FILENO, line.data(), line.size()) < 0) {
+        // nothing more to report with
+      }
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+#endif
+    throw nystrom::cli::ReportedUsageError(why);
   }
 
   /// A failure on this rank alone during the run (out of memory, a system error): the other ranks would wait
