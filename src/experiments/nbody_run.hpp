@@ -37,16 +37,17 @@ inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& set
   if (!(h > 0) || !std::isfinite(h)) throw std::invalid_argument("the step size must be positive");
   if (steps <= 0 || steps > 100000000) throw std::invalid_argument("the number of steps must be between 1 and 1e8");
   const MethodDef def = resolve_solve_method(method);
-  const bool gbs = def.info.adaptive;  // GBS and the adaptive RKN and MPE methods: a tolerance, not steps
-  if (gbs && !(tol > 0)) throw std::invalid_argument("'" + def.info.name + "' is adaptive: it needs a positive --tol");
-  if (!gbs && tol != 0) throw std::invalid_argument("--tol applies to adaptive methods only");
+  const bool adaptive = def.info.adaptive;  // GBS and the adaptive RKN and MPE methods: a tolerance, not steps
+  if (adaptive && !(tol > 0))
+    throw std::invalid_argument("'" + def.info.name + "' is adaptive: it needs a positive --tol");
+  if (!adaptive && tol != 0) throw std::invalid_argument("--tol applies to adaptive methods only");
   const NBodyInstance inst = make_nbody_instance(setup);
   const auto& s0 = inst.particles.s;
   const double span = h * static_cast<double>(steps);
   const SecondOrderProblem prob(inst.force, s0.q, s0.v, 0.0, span);
   SolveOptions opt;
   opt.t_eval = {0.0};  // only the final state is kept
-  if (gbs) {
+  if (adaptive) {
     opt.rtol = opt.atol = tol;
   } else {
     opt.steps = steps;
@@ -69,8 +70,8 @@ inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& set
     const auto rel = [](const State<std::vector<double>>& x) {
       return State<std::array<double, 2>>{{x.q[1] - x.q[0], x.q[3] - x.q[2]}, {x.v[1] - x.v[0], x.v[3] - x.v[2]}};
     };
-    r.position_error = (gbs ? kepler_reference_errors(rel(s0), rel(s), span, 1)
-                            : kepler_reference_errors(rel(s0), rel(s), r.h, sol.accepted))
+    r.position_error = (adaptive ? kepler_reference_errors(rel(s0), rel(s), span, 1)
+                                 : kepler_reference_errors(rel(s0), rel(s), r.h, sol.accepted))
                            .position;
     r.reference = "exact Kepler orbit of the initial state";
   } else {
