@@ -281,7 +281,8 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     force : callable or nystrom.problems.Problem
         ``force(t, q) -> array`` of exactly ``q``'s shape (called once per force evaluation with the time of
         the stage; exceptions propagate unchanged), or a built-in problem (runs entirely in C++ with the GIL
-        released). The time is integrated as one more coordinate (velocity 1), exactly by every method.
+        released). The time is integrated as one more coordinate (velocity 1), exactly by every method;
+        complex-coefficient methods pass complex ``t`` and ``q`` (use numpy functions, not ``math``).
         ``force(t, q, v)`` (three parameters without defaults) is a velocity-dependent force: it runs with
         the methods for y'' = f(t, y, y') only (``GBS``; the others are refused with ValueError).
     q0, v0 : array_like

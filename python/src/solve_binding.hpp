@@ -128,7 +128,7 @@ inline py::array_t<double> rows_array(const std::vector<double>& flat, std::size
   return a;
 }
 
-/// sol(t) of a Solution<V>: its first n coordinates (a Python force's state carries the time last).
+/// sol(t) of a Solution<V> with n coordinates.
 /// mpfr_bits > 0: the MPFR working precision of the run, set again around every evaluation.
 template <class V>
 class DenseSolutionOf final : public DenseSolution {
@@ -155,29 +155,22 @@ class DenseSolutionOf final : public DenseSolution {
   long mpfr_bits_;
 };
 
-/// Runs solve() for state type V and force F. time_coordinate: the force reads the time from one more
-/// coordinate, the last (a Python force(t, q)); the engines integrate it exactly, as solve() does for a
-/// time-dependent force, and complex-coefficient methods can run on it too.
+/// Runs solve() for state type V and force F (python_force: a Python callable, called with the GIL).
 template <class V, class F>
-py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool python_force, long mpfr_bits = 0) {
+py::dict run_solve(F force, const SolveRequest& r, bool python_force, long mpfr_bits = 0) {
   using R = real_t<typename V::value_type>;
   const std::size_t n = r.q0.size();
-  const std::size_t m = n + (time_coordinate ? 1 : 0);
   V q0{}, v0{};
-  if constexpr (requires { q0.resize(m); }) {
-    q0.resize(m);
-    v0.resize(m);
+  if constexpr (requires { q0.resize(n); }) {
+    q0.resize(n);
+    v0.resize(n);
   }
-  if (q0.size() != m)
+  if (q0.size() != n)
     throw invalid_input("the state has " + std::to_string(n) + " coordinates, this problem " +
                         std::to_string(q0.size()));
   for (std::size_t i = 0; i < n; ++i) {
     q0[i] = R(r.q0[i]);
     v0[i] = R(r.v0[i]);
-  }
-  if (time_coordinate) {
-    q0[n] = R(r.t0);
-    v0[n] = R(1);
   }
   const SecondOrderProblem<V, F> prob(std::move(force), std::move(q0), std::move(v0), R(r.t0), R(r.t1));
 
@@ -203,7 +196,7 @@ py::dict run_solve(F force, const SolveRequest& r, bool time_coordinate, bool py
   opt.partial_on_failure = true;  // a failed run returns the states it reached, with status -1
   // Interruption checks (Ctrl-C) and progress every on_step_every steps: about 2^22 coordinate updates apart,
   // or every 64 steps when Python runs at every step anyway.
-  const long work = static_cast<long>(m) * std::max(1, r.method.info.forces_per_step);
+  const long work = static_cast<long>(n) * std::max(1, r.method.info.forces_per_step);
   opt.on_step_every = python_every_step ? 64 : std::max(1L, (1L << 22) / std::max(1L, work));
   opt.on_step = [&](double t) {
     py::gil_scoped_acquire hold;

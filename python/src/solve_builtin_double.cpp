@@ -10,14 +10,14 @@
 namespace nystrom::python {
 
 py::dict solve_builtin_double(const std::string& problem, const std::vector<double>& params, const SolveRequest& r) {
-  if (problem == "kepler") return run_solve<std::array<double, 2>>(KeplerForce{}, r, false, false);
+  if (problem == "kepler") return run_solve<std::array<double, 2>>(KeplerForce{}, r, false);
   if (problem == "nbody") {
     std::vector<double> gm(params.begin() + 1, params.end());
     if (gm.size() * 3 != r.q0.size()) throw invalid_input("N-body state must hold 3 coordinates per particle");
-    return run_solve<std::vector<double>>(NBodyForce<double>(std::move(gm), params.at(0)), r, false, false);
+    return run_solve<std::vector<double>>(NBodyForce<double>(std::move(gm), params.at(0)), r, false);
   }
   if (problem == "henon_heiles" || problem == "harmonic")
-    return run_solve<std::vector<double>>(SmallProblemForce::of(problem, params, r.q0.size()), r, false, false);
+    return run_solve<std::vector<double>>(SmallProblemForce::of(problem, params, r.q0.size()), r, false);
   throw invalid_input("unknown built-in problem '" + problem + "'");
 }
 

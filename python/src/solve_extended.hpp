@@ -9,7 +9,7 @@ namespace nystrom::python {
 
 template <class T>
 py::dict solve_small(const SmallProblemForce& force, const SolveRequest& r, long mpfr_bits = 0) {
-  return run_solve<std::vector<T>>(force, r, false, false, mpfr_bits);
+  return run_solve<std::vector<T>>(force, r, false, mpfr_bits);
 }
 
 py::dict solve_small_long_double(const SmallProblemForce& force, const SolveRequest& r);

@@ -1,10 +1,8 @@
 // solve() on a Python force(t, q) in double, for real and complex coefficients, and on a velocity-dependent
 // force(t, q, v).
 //
-// The state carries the time as one more coordinate, the last (velocity 1, acceleration 0): every method
-// integrates it exactly (drifts move it by c h, RKN stages by c_i h, the multi-product combination has
-// coefficients summing to 1), and the force gets the time of each stage. A complex-coefficient method
-// passes complex arrays to the force.
+// solve() gives the force the time of each stage (it integrates the time exactly, as one more coordinate). A
+// complex-coefficient method passes complex arrays and a complex time to the force.
 #include <algorithm>
 #include <complex>
 #include <string>
@@ -22,28 +20,26 @@ std::string shape_text(const py::ssize_t* dims, std::size_t ndim) {
   return s + (ndim == 1 ? ",)" : ")");
 }
 
-/// force(t, q) called once per force evaluation with q shaped like the user's q0 (the first n
-/// coordinates) and t from coordinate n. The run goes on without the GIL: each call takes it for the call
-/// only (fn is borrowed from the caller, who keeps it alive, so that copies of this functor touch no
-/// reference count).
+/// force(t, q) called once per force evaluation with q shaped like the user's q0. The run goes on without
+/// the GIL: each call takes it for the call only (fn is borrowed from the caller, who keeps it alive, so that
+/// copies of this functor touch no reference count).
 struct PyForce {
   py::handle fn;
   std::vector<py::ssize_t> shape;
   std::size_t n = 0;
 
-  template <class W>
-  requires(std::is_same_v<typename W::value_type, double> ||
-           std::is_same_v<typename W::value_type, std::complex<double>>) void
-  operator()(const W& q, W& a) const {
-    using S = typename W::value_type;
+  /// Real (double) or complex (std::complex<double>) time and states.
+  template <class S>
+  requires(std::is_same_v<S, double> || std::is_same_v<S, std::complex<double>>) void operator()(
+      const S& t, const std::vector<S>& q, std::vector<S>& a) const {
     py::gil_scoped_acquire hold;
     py::array_t<S> arr(shape);
     S* dst = arr.mutable_data();
     for (std::size_t i = 0; i < n; ++i) dst[i] = q[i];
-    read<S>(fn(to_double(q[n]), arr), "force(t, q)", a);
+    read<S>(fn(t, arr), "force(t, q)", a);
   }
 
-  /// The result r of the call `what` into a[0..n), a[n] = 0: exactly q's shape.
+  /// The result r of the call `what` into a[0..n): exactly q's shape.
   template <class S, class W>
   void read(const py::object& r, const char* what, W& a) const {
     using Arr = py::array_t<S, py::array::c_style | py::array::forcecast>;
@@ -62,13 +58,11 @@ struct PyForce {
                             shape_text(shape.data(), shape.size()) + ": it must return q's shape");
     const S* src = res.data();
     for (std::size_t i = 0; i < n; ++i) a[i] = src[i];
-    a[n] = S(0);
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   }
 };
 
-/// force(t, q, v): the same with the velocity, and the time solve() gives a velocity-dependent force (exact
-/// at every stage; coordinate n of q and v, the time and its rate, are not passed).
+/// force(t, q, v): the same with the velocity.
 struct PyVelocityForce {
   PyForce base;
   void operator()(const double& t, const std::vector<double>& q, const std::vector<double>& v,
@@ -91,8 +85,8 @@ py::dict solve_python_force(py::object force, std::vector<py::ssize_t> shape, co
   SolveRequest req = r;
   req.options.mpe_schedule = MpeSchedule::sequential;  // one thread calls the force
   const std::size_t n = r.q0.size();
-  if (velocity) return run_solve<std::vector<double>>(PyVelocityForce{{force, shape, n}}, req, true, true);
-  return run_solve<std::vector<double>>(PyForce{force, std::move(shape), n}, req, true, true);
+  if (velocity) return run_solve<std::vector<double>>(PyVelocityForce{{force, shape, n}}, req, true);
+  return run_solve<std::vector<double>>(PyForce{force, std::move(shape), n}, req, true);
 }
 
 }  // namespace nystrom::python

@@ -80,17 +80,34 @@ struct extended<std::vector<S, A>, true> {
   using type = std::vector<S>;
 };
 
+/// The user's time from the time coordinate tau of the engine's vector: real, or complex for a
+/// complex-coefficient method (its stages lie at complex times, as its positions are complex).
+template <class R, class S>
+auto user_time(int dir, const S& tau) {
+  using T = std::conditional_t<is_complex_v<S>, S, R>;
+  const T t = T(tau);
+  return dir > 0 ? t : T(-t);
+}
+
+/// The user's state type V with the scalar of the engine's vector VE: V itself, or its complex counterpart
+/// for a complex-coefficient method.
+template <class V, class VE>
+using engine_user_vector_t =
+    std::conditional_t<is_complex_v<typename VE::value_type> && !is_complex_v<typename V::value_type>,
+                       rebind_vector_t<V, typename VE::value_type>, V>;
+
 /// The force on the engine's vector: the user's force, time-reversed for backward integration
 /// (dir = -1: t = -tau, and the user's velocity is -dq/dtau) and with t read from the extra coordinate when
-/// it is time-dependent. A velocity-dependent force is called as force(q, v, a) by the engine (GBS's
-/// midpoint base).
+/// it is time-dependent (a complex time for a complex-coefficient method). A velocity-dependent force is
+/// called as force(q, v, a) by the engine (GBS's midpoint base).
 template <class V, class VE, class F, bool TD>
 struct EngineForce {
   static constexpr bool VD = VelocityForce<F, V>;
+  using W = engine_user_vector_t<V, VE>;
   F f;
   int dir = 1;
   std::size_t n = 0;
-  V qb{}, ab{}, vb{};
+  W qb{}, ab{}, vb{};
   void operator()(const VE& q, VE& a) requires(!VD) {
     if constexpr (!TD) {
       f(q, a);
@@ -100,22 +117,20 @@ struct EngineForce {
       resize_like_n(qb, n);
       resize_like_n(ab, n);
       for (std::size_t i = 0; i < n; ++i) qb[i] = q[i];
-      const R t = dir > 0 ? R(q[n]) : R(-q[n]);
-      f(t, static_cast<const V&>(qb), ab);
+      f(user_time<R>(dir, q[n]), static_cast<const W&>(qb), ab);
       check_size(ab, n);
       for (std::size_t i = 0; i < n; ++i) a[i] = ab[i];
       a[n] = typename VE::value_type(0);
     }
   }
   void operator()(const VE& q, const VE& v, VE& a) requires(VD) {
-    using R = real_t<typename V::value_type>;
     if constexpr (!TD) {
       if (dir > 0) {
         f(q, v, a);
       } else {
         resize_like_n(vb, n);
         for (std::size_t i = 0; i < n; ++i) vb[i] = -v[i];
-        f(q, static_cast<const V&>(vb), a);
+        f(q, static_cast<const W&>(vb), a);
       }
       check_size(a, q.size());
     } else {
@@ -126,8 +141,7 @@ struct EngineForce {
         qb[i] = q[i];
         vb[i] = dir > 0 ? v[i] : -v[i];
       }
-      const R t = dir > 0 ? R(q[n]) : R(-q[n]);
-      f(t, static_cast<const V&>(qb), static_cast<const V&>(vb), ab);
+      f(user_time<real_t<typename V::value_type>>(dir, q[n]), static_cast<const W&>(qb), static_cast<const W&>(vb), ab);
       check_size(ab, n);
       for (std::size_t i = 0; i < n; ++i) a[i] = ab[i];
       a[n] = typename VE::value_type(0);
@@ -143,8 +157,8 @@ struct EngineForce {
       (void)a, (void)want;
     }
   }
-  static void resize_like_n(V& x, std::size_t m) {
-    if constexpr (!is_std_array<V>::value) {
+  static void resize_like_n(W& x, std::size_t m) {
+    if constexpr (!is_std_array<W>::value) {
       if (x.size() != m) x.resize(m);
     } else {
       (void)x, (void)m;
@@ -778,12 +792,14 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
   } else if (def.info.complex) {
     using C = std::complex<R>;
     using VC = rebind_vector_t<V, C>;
-    if constexpr (!td && std::is_invocable_v<F&, const VC&, VC&>) {
-      run_fixed<VC>(prob, def, opt, events, sol, dir, resume);
+    constexpr bool accepts_complex =
+        td ? std::is_invocable_v<F&, const C&, const VC&, VC&> : std::is_invocable_v<F&, const VC&, VC&>;
+    if constexpr (accepts_complex) {
+      run_fixed<typename extended<VC, td>::type>(prob, def, opt, events, sol, dir, resume);
     } else {
       throw invalid_input("method '" + def.info.name +
-                          "' has complex coefficients: its force must accept complex states (a generic lambda or a "
-                          "template operator()) and not depend on time");
+                          "' has complex coefficients: its force must accept complex states (and a complex time "
+                          "if it depends on time: a generic lambda or a template operator())");
     }
   } else {
     run_fixed<VE>(prob, def, opt, events, sol, dir, resume);

@@ -3,8 +3,8 @@
 //
 // ErasedForce<T> owns a copy of the user's callable (a lambda, capturing or not, or any functor) and calls
 // it through a function pointer: force(t, q, a) on std::vector<T> states, force(t, q, v, a) when the
-// force depends on the velocity, and force(q, a) on complex states when the callable accepts them
-// (complex-coefficient methods). Copies are deep, as copies of the
+// force depends on the velocity, and force(q, a) or force(t, q, a) on complex states (and a complex time)
+// when the callable accepts them (complex-coefficient methods). Copies are deep, as copies of the
 // callable itself would be: an engine that gives each thread its own force (the concurrent multi-product
 // schedule) gets its own copy of the user's functor, exactly as on the inline path.
 //
@@ -35,12 +35,14 @@ template <class T>
 class ErasedForce {
  public:
   using V = std::vector<T>;
-  using VC = std::vector<std::complex<T>>;
+  using C = std::complex<T>;
+  using VC = std::vector<C>;
 
   ErasedForce() = default;
 
   /// Wraps a copy of f, a force for states V in any form of SecondOrderProblem (force(q, a),
-  /// force(t, q, a), force(q, v, a) or force(t, q, v, a)); force(q, a) on complex states when f accepts them.
+  /// force(t, q, a), force(q, v, a) or force(t, q, v, a)); force(q, a) or force(t, q, a) on complex states
+  /// and times when f accepts them.
   template <class F>
   requires(!std::is_same_v<std::decay_t<F>, ErasedForce>) explicit ErasedForce(const F& f)
       : obj_(new F(f)), ops_(&ops_for<F>) {}
@@ -60,7 +62,8 @@ class ErasedForce {
   bool time_dependent() const { return ops_ && ops_->time_dependent; }
   /// Whether the wrapped force takes the velocity (force(q, v, a) or force(t, q, v, a)).
   bool velocity_dependent() const { return ops_ && ops_->velocity != nullptr; }
-  /// Whether it accepts complex states (complex-coefficient methods).
+  /// Whether it accepts complex states (and a complex time if it takes the time): complex-coefficient
+  /// methods.
   bool accepts_complex() const { return ops_ && ops_->complex != nullptr; }
 
   /// a = a(t, q) (t is ignored by a time-independent force).
@@ -75,14 +78,15 @@ class ErasedForce {
     ops_->velocity(obj_, t, q, v, a);
     if (a.size() != n) erased_detail::resized(a.size(), n);
   }
-  /// a = a(q) on complex states; invalid_input when the force does not accept them.
-  void operator()(const VC& q, VC& a) {
+  /// a = a(t, q) on complex states and times (t is ignored by a time-independent force); invalid_input when
+  /// the force does not accept them.
+  void operator()(const C& t, const VC& q, VC& a) {
     if (!accepts_complex())
       throw invalid_input(
-          "this method has complex coefficients: its force must accept complex states (a generic lambda or a "
-          "template operator()) and not depend on time");
+          "this method has complex coefficients: its force must accept complex states (and a complex time if it "
+          "depends on time: a generic lambda or a template operator())");
     const std::size_t n = a.size();
-    ops_->complex(obj_, q, a);
+    ops_->complex(obj_, t, q, a);
     if (a.size() != n) erased_detail::resized(a.size(), n);
   }
 
@@ -90,66 +94,75 @@ class ErasedForce {
   struct Ops {
     void (*real)(void*, const T&, const V&, V&);
     void (*velocity)(void*, const T&, const V&, const V&, V&);
-    void (*complex)(void*, const VC&, VC&);
+    void (*complex)(void*, const C&, const VC&, VC&);
     void* (*clone)(const void*);
     void (*destroy)(void*);
     bool time_dependent;
   };
   template <class F>
-  static constexpr Ops ops_for = {[] {
-                                    if constexpr (VelocityForce<F, V>)
-                                      return static_cast<void (*)(void*, const T&, const V&, V&)>(nullptr);
-                                    else
-                                      return +[](void* p, const T& t, const V& q, V& a) {
-                                        F& f = *static_cast<F*>(p);
-                                        if constexpr (AutonomousForce<F, V>) {
-                                          (void)t;
-                                          f(q, a);
-                                        } else {
-                                          f(t, q, a);
-                                        }
-                                      };
-                                  }(),
-                                  [] {
-                                    if constexpr (VelocityForce<F, V>)
-                                      return +[](void* p, const T& t, const V& q, const V& v, V& a) {
-                                        F& f = *static_cast<F*>(p);
-                                        if constexpr (AutonomousVelocityForce<F, V>) {
-                                          (void)t;
-                                          f(q, v, a);
-                                        } else {
-                                          f(t, q, v, a);
-                                        }
-                                      };
-                                    else
-                                      return static_cast<void (*)(void*, const T&, const V&, const V&, V&)>(nullptr);
-                                  }(),
-                                  [] {
-                                    if constexpr (AutonomousForce<F, V> && std::is_invocable_v<F&, const VC&, VC&>)
-                                      return +[](void* p, const VC& q, VC& a) { (*static_cast<F*>(p))(q, a); };
-                                    else
-                                      return static_cast<void (*)(void*, const VC&, VC&)>(nullptr);
-                                  }(),
-                                  [](const void* p) -> void* { return new F(*static_cast<const F*>(p)); },
-                                  [](void* p) { delete static_cast<F*>(p); },
-                                  !AutonomousForce<F, V>};
+  static constexpr Ops ops_for = {
+      [] {
+        if constexpr (VelocityForce<F, V>)
+          return static_cast<void (*)(void*, const T&, const V&, V&)>(nullptr);
+        else
+          return +[](void* p, const T& t, const V& q, V& a) {
+            F& f = *static_cast<F*>(p);
+            if constexpr (AutonomousForce<F, V>) {
+              (void)t;
+              f(q, a);
+            } else {
+              f(t, q, a);
+            }
+          };
+      }(),
+      [] {
+        if constexpr (VelocityForce<F, V>)
+          return +[](void* p, const T& t, const V& q, const V& v, V& a) {
+            F& f = *static_cast<F*>(p);
+            if constexpr (AutonomousVelocityForce<F, V>) {
+              (void)t;
+              f(q, v, a);
+            } else {
+              f(t, q, v, a);
+            }
+          };
+        else
+          return static_cast<void (*)(void*, const T&, const V&, const V&, V&)>(nullptr);
+      }(),
+      [] {
+        using Complex = void (*)(void*, const C&, const VC&, VC&);
+        if constexpr (AutonomousForce<F, V> && std::is_invocable_v<F&, const VC&, VC&>)
+          return Complex{+[](void* p, const C&, const VC& q, VC& a) { (*static_cast<F*>(p))(q, a); }};
+        else if constexpr (TimeDependentForce<F, V> && std::is_invocable_v<F&, const C&, const VC&, VC&>)
+          return Complex{+[](void* p, const C& t, const VC& q, VC& a) { (*static_cast<F*>(p))(t, q, a); }};
+        else
+          return Complex{nullptr};
+      }(),
+      [](const void* p) -> void* { return new F(*static_cast<const F*>(p)); },
+      [](void* p) { delete static_cast<F*>(p); },
+      !AutonomousForce<F, V>};
 
   void* obj_ = nullptr;
   const Ops* ops_ = nullptr;
 };
 
-/// The forms the compiled drivers are instantiated for: a time-independent force (with its complex
-/// form), and a time-dependent one.
+/// The forms the compiled drivers are instantiated for: a time-independent force and a time-dependent one
+/// (each with its complex form).
 template <class T>
 struct ErasedAutonomous {
   ErasedForce<T> f;
   void operator()(const std::vector<T>& q, std::vector<T>& a) { f(T(0), q, a); }
-  void operator()(const std::vector<std::complex<T>>& q, std::vector<std::complex<T>>& a) { f(q, a); }
+  void operator()(const std::vector<std::complex<T>>& q, std::vector<std::complex<T>>& a) {
+    f(std::complex<T>(0), q, a);
+  }
 };
 template <class T>
 struct ErasedTimed {
   ErasedForce<T> f;
   void operator()(const T& t, const std::vector<T>& q, std::vector<T>& a) { f(t, q, a); }
+  void operator()(const std::complex<T>& t, const std::vector<std::complex<T>>& q, std::vector<std::complex<T>>& a) {
+    f(t, q, a);
+  }
 };
 /// A velocity-dependent force (always given the time: one instantiation for both of its forms).
 template <class T>
