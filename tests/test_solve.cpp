@@ -713,6 +713,24 @@ TEST(SolveCheckpoint, RestartIsBitwiseTheUninterruptedRun) {
     SolveOptions other = c.opt;
     other.checkpoint_problem = "kepler e=0.5";
     EXPECT_THROW(resume(prob, def, cp, other), invalid_input);
+    // Output times from the checkpoint's time on: the same states; one before it is refused (the resumed run
+    // has no state there).
+    SolveOptions timed = c.opt;
+    timed.t_eval = {cp.t, 20.0, 30.0};
+    const auto third = resume(prob, def, cp, timed);
+    ASSERT_EQ(third.q.size(), 3u);
+    EXPECT_EQ(third.t[0], cp.t);
+    EXPECT_EQ(third.q[0], (V2{cp.state[0], cp.state[1]}));
+    EXPECT_EQ(third.q[2], plain.q_final);
+    EXPECT_EQ(third.q_final, plain.q_final);
+    timed.t_eval = {12.0, 20.0};
+    try {
+      resume(prob, def, cp, timed);
+      ADD_FAILURE() << "an output time before the checkpoint was accepted";
+    } catch (const invalid_input& e) {
+      EXPECT_NE(std::string(e.what()).find("output time 12 lies before the checkpoint's time"), std::string::npos)
+          << e.what();
+    }
   }
   EXPECT_THROW(checkpoint_from_text<double>("nystrom-checkpoint 99\n"), invalid_input);
   EXPECT_THROW(checkpoint_from_text<double>("garbage"), invalid_input);

@@ -836,6 +836,11 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
                         opt.checkpoint_problem + "')");
   if (resume && resume->method != def.info.name)
     throw invalid_input("the checkpoint was taken with method '" + resume->method + "', not '" + def.info.name + "'");
+  // A resumed run starts at the checkpoint's time: it has no state for an output time before it.
+  if (resume && !opt.t_eval.empty() && sgn_mul(dir, R(opt.t_eval.front())) < sgn_mul(dir, resume->t))
+    throw invalid_input("output time " + adaptive_detail::sci(opt.t_eval.front()) +
+                        " lies before the checkpoint's time " + adaptive_detail::sci(as_double(resume->t)) +
+                        ", where the resumed run starts");
   if (prob.t1 == prob.t0) {
     Recorder<V, P> rec(prob, opt, events, sol, dir, {});
     rec.start(prob.t0, prob.q0, prob.v0);
