@@ -125,7 +125,7 @@ RunReport run_nbody_case(const RunRequest& req, const MethodDef& def) {
 
 }  // namespace
 
-RunReport run_case(const RunRequest& req, const MethodDef& def) {
+void check_run_request(const RunRequest& req, const MethodDef& def) {
   if (def.info.family == "mpe-midpoint")
     throw UsageError("method '" + def.info.name +
                      "' is for velocity-dependent forces (--problem arenstorf, damped-oscillator); for --problem " +
@@ -140,22 +140,24 @@ RunReport run_case(const RunRequest& req, const MethodDef& def) {
     throw UsageError("method '" + def.info.name + "' is adaptive: give a positive --tol");
   if (!def.info.adaptive && req.tol != 0)
     throw UsageError("--tol applies to adaptive methods only; '" + def.info.name + "' runs with fixed steps");
-  if (req.problem == "nbody" || req.problem == "twobody") {
-    RunReport r = run_nbody_case(req, def);
-    r.method = def.info.name;
-    r.family = def.info.family;
-    r.order = def.info.order;
-    r.problem = req.problem;
-    r.precision = req.precision;
-    return r;
-  }
-  RunReport r = dispatch_precision(
-      req.precision, [&](auto tag) -> RunReport { return run_in_precision<typename decltype(tag)::type>(req, def); });
+}
+
+void label_report(RunReport& r, const RunRequest& req, const MethodDef& def) {
   r.method = def.info.name;
   r.family = def.info.family;
   r.order = def.info.order;
   r.problem = req.problem;
   r.precision = req.precision;
+}
+
+RunReport run_case(const RunRequest& req, const MethodDef& def) {
+  check_run_request(req, def);
+  RunReport r = req.problem == "nbody" || req.problem == "twobody"
+                    ? run_nbody_case(req, def)
+                    : dispatch_precision(req.precision, [&](auto tag) -> RunReport {
+                        return run_in_precision<typename decltype(tag)::type>(req, def);
+                      });
+  label_report(r, req, def);
   return r;
 }
 

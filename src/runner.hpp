@@ -101,4 +101,11 @@ const std::vector<std::string>& problem_names();
 /// Validates the request (throws std::invalid_argument with a clear message) and runs it.
 RunReport run_case(const RunRequest& req, const MethodDef& method);
 
+/// run_case's checks of a request for `method` that hold for every problem (the steps, the periods, the
+/// tolerance; throws UsageError).
+void check_run_request(const RunRequest& req, const MethodDef& method);
+
+/// Fills the method, its family and order, the problem and the precision of a report.
+void label_report(RunReport& r, const RunRequest& req, const MethodDef& method);
+
 }  // namespace nystrom::cli

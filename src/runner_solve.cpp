@@ -1,18 +1,15 @@
-// `nystrom run --problem kepler` through solve(): output times from the dense output, events,
-// checkpoint and restart (double precision).
-#include <algorithm>
+// `nystrom run --problem kepler` with output times, events, checkpoint and restart (double precision): the
+// options read into RunOutputs for run_orbit (runner_typed.hpp), its solution into JSON.
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli.hpp"
-#include "nystrom/problems/kepler.hpp"
-#include "nystrom/problems/reference.hpp"
-#include "nystrom/solve/solve.hpp"
+#include "nystrom/solve/checkpoint.hpp"
 #include "runner_solve.hpp"
 
 namespace nystrom::cli {
@@ -65,93 +62,46 @@ nlohmann::json vec(const V2& x) { return nlohmann::json::array({x[0], x[1]}); }
 SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq, const MethodDef& def) {
   if (req.problem != "kepler")
     throw UsageError("--output-times, --events, --checkpoint and --restart run on the kepler problem");
-  if (req.steps_per_period <= 0) throw UsageError("--steps-per-period must be a positive integer");
-  if (req.periods <= 0) throw UsageError("--periods must be a positive integer");
-  if (req.steps_per_period > 1'000'000'000L / req.periods)
-    throw UsageError("too many steps requested (steps-per-period x periods must be at most 1e9)");
-  if (def.info.adaptive && !(req.tol > 0 && std::isfinite(req.tol)))
-    throw UsageError("method '" + def.info.name + "' is adaptive: give a positive --tol");
-  if (!def.info.adaptive && req.tol != 0)
-    throw UsageError("--tol applies to adaptive methods only; '" + def.info.name + "' runs with fixed steps");
+  check_run_request(req, def);
   if (req.precision != "double")
     throw UsageError("--output-times, --events, --checkpoint and --restart run in double precision");
-  if (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1)
-    throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
   if (sreq.checkpoint.empty() != std::isnan(sreq.checkpoint_at))
     throw UsageError("--checkpoint FILE and --checkpoint-at T go together");
   if (!sreq.checkpoint.empty() && !sreq.restart.empty() && sreq.checkpoint == sreq.restart)
     throw UsageError("--checkpoint and --restart name the same file");
-  const KeplerProblem<double> kp(req.ecc);
-  const auto s0 = kp.initial_state();
-  const double t_end = KeplerProblem<double>::period() * static_cast<double>(req.periods);
-  const SecondOrderProblem prob(KeplerForce{}, s0.q, s0.v, 0.0, t_end);
-  const bool tolerance = def.info.adaptive;
-  SolveOptions opt;
-  if (tolerance)
-    opt.rtol = req.tol;
-  else
-    opt.steps = req.steps_per_period * req.periods;
-  opt.max_steps = std::max(opt.max_steps, opt.steps);
-  opt.keep_complex = req.keep_complex;
-  opt.dense = false;  // output times and events are taken as the run goes (partial steps of the method)
-  if (!sreq.output_times.empty()) opt.t_eval = parse_output_times(sreq.output_times);
-  for (double t : opt.t_eval)
-    if (t < 0 || t > t_end)
-      throw UsageError("--output-times: every time must lie in the integrated span [0, " + std::to_string(t_end) + "]");
-  const auto events = sreq.events.empty() ? std::vector<Event<V2>>{} : parse_events(sreq.events);
+  RunOutputs<V2> outputs;
+  if (!sreq.output_times.empty()) outputs.t_eval = parse_output_times(sreq.output_times);
+  if (!sreq.events.empty()) outputs.events = parse_events(sreq.events);
   // What a checkpoint must match: everything that defines the steps, except the end of the span.
+  const bool tolerance = def.info.adaptive;
   char tag[256];
   std::snprintf(tag, sizeof tag, "kepler ecc=%a precision=double %s=%a keep_complex=%d", req.ecc,
                 tolerance ? "tol" : "steps_per_period", tolerance ? req.tol : static_cast<double>(req.steps_per_period),
                 req.keep_complex ? 1 : 0);
-  opt.checkpoint_problem = tag;
+  outputs.checkpoint_problem = tag;
   if (!sreq.checkpoint.empty()) {
     if (!(sreq.checkpoint_at >= 0) || !std::isfinite(sreq.checkpoint_at))
       throw UsageError("--checkpoint-at must be a finite time >= 0");
-    opt.checkpoint_at = sreq.checkpoint_at;
+    outputs.checkpoint_at = sreq.checkpoint_at;
     const std::string file = sreq.checkpoint;
     // atomically, its temporary file removed on SIGINT/SIGTERM too; a link or a non-regular file is refused
-    opt.on_checkpoint = [file](const std::string& text) { write_checkpoint_text(file, text); };
+    outputs.on_checkpoint = [file](const std::string& text) { write_checkpoint_text(file, text); };
   }
-  const auto w0 = std::chrono::steady_clock::now();
-  Solution<V2> sol;
-  try {
-    if (sreq.restart.empty()) {
-      sol = solve(prob, def, opt, events);
-    } else {
-      const auto cp = read_checkpoint<double>(sreq.restart);
-      if (cp.t > t_end) throw UsageError("the checkpoint lies after the end of the span");
-      sol = resume(prob, def, cp, opt, events);
+  if (!sreq.restart.empty()) {
+    try {
+      outputs.restart = read_checkpoint<double>(sreq.restart);
+    } catch (const invalid_input& e) {
+      throw UsageError(e.what());
     }
-  } catch (const invalid_input& e) {
-    throw UsageError(e.what());
   }
-  const auto w1 = std::chrono::steady_clock::now();
+  auto run = run_orbit<double, 2>(req, def, outputs);
+  const Solution<V2>& sol = run.sol;
   if (!sreq.checkpoint.empty() && !sol.checkpoint)
     throw UsageError("--checkpoint-at lies at or after the end of the run: no checkpoint was written");
 
   SolveRunResult result;
-  RunReport& r = result.report;
+  result.report = std::move(run.report);
   auto& extra = result.extra;
-  r.method = def.info.name;
-  r.family = def.info.family;
-  r.order = def.info.order;
-  r.problem = req.problem;
-  r.precision = req.precision;
-  r.ecc = req.ecc;
-  r.steps = sol.accepted;
-  r.force_evals = sol.force_evals;
-  r.h = tolerance ? t_end / static_cast<double>(sol.accepted > 0 ? sol.accepted : 1)
-                  : KeplerProblem<double>::period() / static_cast<double>(req.steps_per_period);
-  r.seconds = std::chrono::duration<double>(w1 - w0).count();
-  State<V2> s{sol.q_final, sol.v_final};
-  r.precession_per_period = signed_angle(lrl_vector(s0), lrl_vector(s)) / static_cast<double>(req.periods);
-  // against the exact orbit of s0 at the exact end time (problems/reference.hpp): n steps of t_end / n, or
-  // an adaptive run that lands on t_end
-  const long n = tolerance ? 1 : opt.steps;
-  const ReferenceErrors err = kepler_reference_errors(s0, s, t_end / static_cast<double>(n), n);
-  r.energy_error = err.energy;
-  r.position_error = err.position;
   // The final state exactly (the shortest decimal that reads back to the same double: a comparison of
   // two runs' q and v is a bitwise one).
   extra["t"] = sol.t_final;
@@ -165,7 +115,7 @@ SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq,
       out.push_back({{"t", sol.t[i]}, {"q", vec(sol.q[i])}, {"v", vec(sol.v[i])}});
     extra["output"] = out;
   }
-  if (!events.empty()) {
+  if (!outputs.events.empty()) {
     auto out = nlohmann::json::array();
     for (const auto& e : sol.events) out.push_back({{"name", e.name}, {"t", e.t}, {"q", vec(e.q)}, {"v", vec(e.v)}});
     extra["events"] = out;

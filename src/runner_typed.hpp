@@ -8,8 +8,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 #include "cli.hpp"
 #include "nystrom/core/precision.hpp"
@@ -17,6 +19,7 @@
 #include "nystrom/problems/reference.hpp"
 #include "nystrom/solve_inline.hpp"
 #include "runner.hpp"
+#include "runner_solve.hpp"
 
 namespace nystrom::cli {
 
@@ -25,19 +28,28 @@ namespace detail {
 // The force evaluations a fixed-step run of n steps makes (for the progress line; FSAL accounted).
 inline long expected_evals(const MethodDef& def, long n) { return n * std::max(1, def.info.forces_per_step); }
 
-/// The final state of a run of `def` on the problem with initial state s0, force Force and period P (whole
-/// periods: req.periods): fixed steps (req.steps_per_period per period; the step is the span over their
-/// number) or, for an adaptive method and GBS, the tolerance req.tol. Fills the steps (accepted), force
-/// evaluations, step size (the mean accepted step when adaptive) and seconds of r, and h_ref, n_ref: the
-/// exact end time is h_ref n_ref (problems/reference.hpp).
-template <class T, class Force, class S, class Report>
-S run_solve(const MethodDef& def, const RunRequest& req, const S& s0, const T& period, Report& r, T& h_ref,
-            long& n_ref) {
-  const T t_end = period * T(req.periods);
+}  // namespace detail
+
+template <class T, std::size_t N>
+OrbitRun<T, N> run_orbit(const RunRequest& req, const MethodDef& def, const RunOutputs<std::array<T, N>>& outputs) {
+  static_assert(N == 1 || N == 2, "Kepler (N = 2) or the harmonic oscillator (N = 1)");
+  constexpr bool kepler = N == 2;
+  using Problem = std::conditional_t<kepler, KeplerProblem<T>, HarmonicProblem<T>>;
+  using Force = std::conditional_t<kepler, KeplerForce, HarmonicForce>;
+  if (kepler && (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1))
+    throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
+  const Problem problem = [&] {
+    if constexpr (kepler)
+      return Problem(static_cast<T>(req.ecc));
+    else
+      return Problem();
+  }();
+  const auto s0 = problem.initial_state();
+  const T t_end = Problem::period() * T(req.periods);
   const bool adaptive = def.info.adaptive;
   const long n = req.steps_per_period * req.periods;
   std::optional<RunMeter> meter;  // fixed steps: a progress line over the expected force evaluations
-  if (req.progress && !adaptive) meter.emplace(expected_evals(def, n), precision_cost(req.precision));
+  if (req.progress && !adaptive) meter.emplace(detail::expected_evals(def, n), precision_cost(req.precision));
   const SecondOrderProblem prob(MeteredForce<Force>{Force{}, meter ? &*meter : nullptr}, s0.q, s0.v, T(0), t_end);
   SolveOptions opt;
   if (adaptive) {
@@ -47,63 +59,65 @@ S run_solve(const MethodDef& def, const RunRequest& req, const S& s0, const T& p
     opt.max_steps = std::max(opt.max_steps, n);  // the steps asked for (at most 1e9, checked before)
   }
   opt.keep_complex = req.keep_complex;
-  opt.t_eval = {0.0};  // only the final state is kept (Solution::q_final)
+  for (double t : outputs.t_eval)
+    if (t < 0 || T(t) > t_end)
+      throw UsageError("--output-times: every time must lie in the integrated span [0, " +
+                       std::to_string(as_double(t_end)) + "]");
+  // Without output times only the final state is kept (Solution::q_final): the one time saved is the start.
+  opt.t_eval = outputs.t_eval;
+  if (opt.t_eval.empty()) opt.t_eval = {outputs.restart ? as_double(outputs.restart->t) : 0.0};
+  opt.checkpoint_at = outputs.checkpoint_at;
+  opt.checkpoint_problem = outputs.checkpoint_problem;
+  opt.on_checkpoint = outputs.on_checkpoint;
+  OrbitRun<T, N> out;
+  auto& sol = out.sol;
   const auto w0 = std::chrono::steady_clock::now();
-  Solution<decltype(s0.q)> sol;
   try {
-    sol = solve(prob, def, opt);
+    if (outputs.restart) {
+      if (outputs.restart->t > t_end) throw UsageError("the checkpoint lies after the end of the span");
+      sol = resume(prob, def, *outputs.restart, opt, outputs.events);
+    } else {
+      sol = solve(prob, def, opt, outputs.events);
+    }
   } catch (const invalid_input& e) {
     throw UsageError(e.what());
   }
   if (meter) meter->finish();
   const auto w1 = std::chrono::steady_clock::now();
+  RunReport& r = out.report;
+  label_report(r, req, def);
   r.steps = sol.accepted;
   r.force_evals = sol.force_evals;
   r.seconds = std::chrono::duration<double>(w1 - w0).count();
-  h_ref = adaptive ? t_end : T(t_end / T(n));  // the step solve() takes: the span over the number of steps
-  n_ref = adaptive ? 1 : n;
-  r.h = as_double(adaptive ? T(t_end / T(std::max(1L, sol.accepted))) : h_ref);
-  return S{sol.q_final, sol.v_final};
+  // The exact end time is h n (problems/reference.hpp): n steps of the span over n, or one adaptive run.
+  const T h = adaptive ? t_end : T(t_end / T(n));
+  const long steps = adaptive ? 1 : n;
+  r.h = as_double(adaptive ? T(t_end / T(std::max(1L, sol.accepted))) : h);
+  const State<std::array<T, N>> s{sol.q_final, sol.v_final};
+  // against the exact solution from s0 at the exact end time h n, in quad-double or better
+  ReferenceErrors err;
+  if constexpr (kepler) {
+    r.ecc = req.ecc;
+    r.precession_per_period = as_double(signed_angle(lrl_vector(s0), lrl_vector(s)) / T(req.periods));
+    err = kepler_reference_errors(s0, s, h, steps);
+  } else {
+    err = harmonic_reference_errors(s0, s, h, steps);
+  }
+  r.energy_error = err.energy;
+  r.position_error = err.position;
+  r.t = as_double(h * T(steps));
+  for (std::size_t i = 0; i < N; ++i) {
+    r.q.push_back(as_double(s.q[i]));
+    r.v.push_back(as_double(s.v[i]));
+  }
+  return out;
 }
-
-}  // namespace detail
 
 /// Kepler or harmonic run of `def` in scalar type T (validated request).
 template <class T>
 RunReport run_in_precision(const RunRequest& req, const MethodDef& def) {
-  RunReport out;
-  T h{};
-  long n = 0;
-  if (req.problem == "kepler") {
-    if (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1)
-      throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
-    const KeplerProblem<T> prob(static_cast<T>(req.ecc));
-    const auto s0 = prob.initial_state();
-    const auto s = detail::run_solve<T, KeplerForce>(def, req, s0, KeplerProblem<T>::period(), out, h, n);
-    out.ecc = req.ecc;
-    out.precession_per_period = as_double(signed_angle(lrl_vector(s0), lrl_vector(s)) / T(req.periods));
-    // against the exact orbit of s0 at the exact end time h n, in quad-double or better
-    const ReferenceErrors err = kepler_reference_errors(s0, s, h, n);
-    out.energy_error = err.energy;
-    out.position_error = err.position;
-    out.t = as_double(h * T(n));
-    out.q = {as_double(s.q[0]), as_double(s.q[1])};
-    out.v = {as_double(s.v[0]), as_double(s.v[1])};
-    return out;
-  }
-  if (req.problem == "harmonic") {
-    const HarmonicProblem<T> prob;
-    const auto s0 = prob.initial_state();
-    const auto s = detail::run_solve<T, HarmonicForce>(def, req, s0, HarmonicProblem<T>::period(), out, h, n);
-    // against cos t, -sin t at the exact end time h n, in quad-double or better
-    const ReferenceErrors err = harmonic_reference_errors(s0, s, h, n);
-    out.position_error = err.position;
-    out.energy_error = err.energy;
-    out.t = as_double(h * T(n));
-    out.q = {as_double(s.q[0])};
-    out.v = {as_double(s.v[0])};
-    return out;
-  }
+  if (req.problem == "kepler") return run_orbit<T, 2>(req, def, {}).report;
+  if (req.problem == "harmonic") return run_orbit<T, 1>(req, def, {}).report;
   std::string known;
   for (const auto& p : problem_names()) known += (known.empty() ? "" : ", ") + p;
   throw UsageError("unknown problem '" + req.problem + "' (known: " + known + ")");

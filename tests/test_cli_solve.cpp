@@ -196,6 +196,17 @@ TEST(CliSolve, RestartFromACheckpointEndsInBitwiseTheSameState) {
     for (const char* k : {"q", "v"})
       for (int i = 0; i < 2; ++i) EXPECT_EQ(ja.at(k)[i].get<double>(), jb.at(k)[i].get<double>()) << k << i;
     EXPECT_EQ(ja.at("steps"), jb.at("steps"));
+    // Output times from the checkpoint on: the end is the same; one before the checkpoint is refused (the
+    // restarted run has no state there).
+    const auto c = run(base + " --restart " + f + " --output-times 40:" + ja.at("t").dump() + ":3");
+    ASSERT_EQ(c.code, 0) << c.err;
+    const auto jc = nlohmann::json::parse(c.out);
+    EXPECT_EQ(jc.at("output").at(2).at("q"), ja.at("q"));
+    EXPECT_EQ(jc.at("q"), ja.at("q"));
+    const auto early = run(base + " --restart " + f + " --output-times 0:60:5");
+    EXPECT_EQ(early.code, 2);
+    EXPECT_NE(early.err.find("nystrom: error: output time 0 lies before the checkpoint's time 3"), std::string::npos)
+        << early.err;
     // Another method, eccentricity or step count is refused with one clear error.
     const auto other = run("run --problem kepler --ecc 0.5 " + m + " --periods 20 --restart " + f);
     EXPECT_EQ(other.code, 2);

@@ -1,11 +1,13 @@
 // solve(): one driver for every method family, its options, dense output, events and checkpoints.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -149,6 +151,62 @@ TEST(Solve, OutputTimesComeFromTheDenseOutput) {
   // sol(t) anywhere inside.
   for (double t : {0.123, 1.0, 3.3, 6.2}) EXPECT_LT(pos_err(sol(t).q, kp.exact(t)), 1e-10) << t;
   EXPECT_THROW(sol(7.0), invalid_input);
+}
+
+TEST(Solve, OutputTimesOnlyAtTheEndsKeepNoCopyOfTheMethod) {
+  // Output times at the start and the end of the span are step ends: such a run, like one that saves every
+  // step end, takes no partial steps and keeps no copy of the method (and of its force) for them, while an
+  // output time inside the span does. The copies are counted while the force runs (the copies of a
+  // shared_ptr it holds); the states are the same, bit for bit. Fixed steps, an adaptive pair and GBS, both
+  // directions.
+  for (const std::string m : {"M8", "DP12-adaptive", "GBS"}) {
+    for (const double t1 : {3.0, -3.0}) {
+      SCOPED_TRACE(m + (t1 > 0 ? " forward" : " backward"));
+      const auto token = std::make_shared<int>(0);
+      long most = 0;  // the most copies of the force alive at once
+      VdForce f = [token, &most](const Vd& q, Vd& a) {
+        most = std::max(most, token.use_count());
+        a[0] = -q[0];
+      };
+      const SecondOrderProblem prob(f, Vd{1.0}, Vd{0.5}, 0.0, t1);
+      auto run = [&](std::vector<double> t_eval, long& copies) {
+        most = 0;
+        SolveOptions opt{.t_eval = std::move(t_eval)};
+        if (m == "M8")
+          opt.steps = 30;
+        else
+          opt.rtol = 1e-10;
+        auto sol = solve(prob, m, opt);
+        copies = most;
+        return sol;
+      };
+      long every = 0, ends = 0, start = 0, end = 0, inside = 0;
+      const auto a = run({}, every);
+      const auto b = run({0.0, t1}, ends);
+      const auto c = run({0.0}, start);
+      const auto d = run({t1}, end);
+      const auto e = run({0.0, 0.45 * t1, t1}, inside);  // inside a fixed step
+      EXPECT_EQ(ends, every);
+      EXPECT_EQ(start, every);
+      EXPECT_EQ(end, every);
+      EXPECT_GT(inside, every);
+      ASSERT_EQ(b.q.size(), 2u);
+      EXPECT_EQ(b.t, (std::vector<double>{0.0, t1}));
+      EXPECT_EQ(b.q[0], prob.q0);
+      EXPECT_EQ(b.v[0], prob.v0);
+      for (const auto* s : {&b, &c, &d, &e}) {
+        EXPECT_EQ(s->q_final, a.q_final);
+        EXPECT_EQ(s->v_final, a.v_final);
+        EXPECT_EQ(s->force_evals, a.force_evals);
+      }
+      EXPECT_EQ(b.q[1], a.q_final);
+      EXPECT_EQ(b.v[1], a.v_final);
+      EXPECT_EQ(d.q.at(0), a.q_final);
+      EXPECT_EQ(b.output_force_evals, 0);
+      EXPECT_GT(e.output_force_evals, 0);
+      EXPECT_NEAR(e.q.at(1)[0], std::cos(0.45 * t1) + 0.5 * std::sin(0.45 * t1), 1e-8);
+    }
+  }
 }
 
 TEST(Solve, InvalidInputIsRefusedWithOneClearError) {
@@ -655,6 +713,24 @@ TEST(SolveCheckpoint, RestartIsBitwiseTheUninterruptedRun) {
     SolveOptions other = c.opt;
     other.checkpoint_problem = "kepler e=0.5";
     EXPECT_THROW(resume(prob, def, cp, other), invalid_input);
+    // Output times from the checkpoint's time on: the same states; one before it is refused (the resumed run
+    // has no state there).
+    SolveOptions timed = c.opt;
+    timed.t_eval = {cp.t, 20.0, 30.0};
+    const auto third = resume(prob, def, cp, timed);
+    ASSERT_EQ(third.q.size(), 3u);
+    EXPECT_EQ(third.t[0], cp.t);
+    EXPECT_EQ(third.q[0], (V2{cp.state[0], cp.state[1]}));
+    EXPECT_EQ(third.q[2], plain.q_final);
+    EXPECT_EQ(third.q_final, plain.q_final);
+    timed.t_eval = {12.0, 20.0};
+    try {
+      resume(prob, def, cp, timed);
+      ADD_FAILURE() << "an output time before the checkpoint was accepted";
+    } catch (const invalid_input& e) {
+      EXPECT_NE(std::string(e.what()).find("output time 12 lies before the checkpoint's time"), std::string::npos)
+          << e.what();
+    }
   }
   EXPECT_THROW(checkpoint_from_text<double>("nystrom-checkpoint 99\n"), invalid_input);
   EXPECT_THROW(checkpoint_from_text<double>("garbage"), invalid_input);

@@ -476,6 +476,19 @@ def test_restart_from_a_checkpoint_is_bitwise_the_uninterrupted_run(tmp_path, kw
     assert again.q_str == full.q_str and again.v_str == full.v_str
 
 
+def test_restarted_run_takes_output_times_from_the_checkpoint_on(tmp_path):
+    prob = Kepler(E)
+    path = tmp_path / "run.checkpoint"
+    full = nystrom.solve(prob, t_span=(0, 20.0), method="M8", steps=2000, checkpoint=path, checkpoint_at=7.0)
+    again = nystrom.solve(prob, t_span=(0, 20.0), method="M8", steps=2000, restart=path,
+                          t_eval=[full.checkpoint_t, 20.0])
+    assert again.t.tolist() == [full.checkpoint_t, 20.0]
+    assert np.array_equal(again.q[-1], full.q[-1]) and np.array_equal(again.v[-1], full.v[-1])
+    # the resumed run has no state before the checkpoint
+    with pytest.raises(ValueError, match="output time 0 lies before the checkpoint's time"):
+        nystrom.solve(prob, t_span=(0, 20.0), method="M8", steps=2000, restart=path, t_eval=[0.0, 20.0])
+
+
 def test_checkpoint_mismatches_and_bad_files_are_refused(tmp_path):
     prob = Kepler(E)
     path = tmp_path / "run.checkpoint"

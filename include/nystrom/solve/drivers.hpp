@@ -205,11 +205,13 @@ std::size_t unflatten(const std::vector<T>& in, std::size_t pos, VE& x) {
   return pos;
 }
 
-/// Whether a run needs the method's partial steps (output times, events, dense output): without them the
-/// recorder keeps no copy of the method.
-template <class V>
-bool needs_partial_steps(const SolveOptions& opt, const std::vector<Event<V>>& events) {
-  return opt.dense || !opt.t_eval.empty() || !events.empty();
+/// Whether a run from t_start (t0, or the time of the checkpoint it resumes from) to t1 needs the method's
+/// partial steps: for the dense output, events, or an output time other than t_start and t1 (the recorder
+/// saves those two from the step ends). Without them the recorder keeps no copy of the method.
+template <class V, class R>
+bool needs_partial_steps(const SolveOptions& opt, const std::vector<Event<V>>& events, const R& t_start, const R& t1) {
+  if (opt.dense || !events.empty()) return true;
+  return std::any_of(opt.t_eval.begin(), opt.t_eval.end(), [&](double t) { return R(t) != t_start && R(t) != t1; });
 }
 
 /// Conversions between the user's state (time t, q, v) and the engine's (time-reversed for backward
@@ -495,8 +497,9 @@ void run_fixed(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solve
   State<VE> s = run.to_engine(prob.t0, prob.q0, prob.v0);
   long k0 = 0;
   long evals0 = 0;
-  Recorder<V, SecondOrderProblem<V, F>> rec(prob, opt, events, sol, dir,
-                                            needs_partial_steps(opt, events) ? run.partial_step(integ) : nullptr);
+  Recorder<V, SecondOrderProblem<V, F>> rec(
+      prob, opt, events, sol, dir,
+      needs_partial_steps(opt, events, resume ? resume->t : prob.t0, prob.t1) ? run.partial_step(integ) : nullptr);
   if (resume) {
     if (resume->engine != "fixed") throw invalid_input("checkpoint of another engine (" + resume->engine + ")");
     k0 = resume->step_index;
@@ -599,8 +602,10 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const long& calls, const c
     rej0 = resume->rejected;
     sol.output_force_evals = resume->output_force_evals;
   }
-  Recorder<V, SecondOrderProblem<V, F>> rec(
-      prob, run.opt, events, sol, dir, needs_partial_steps(run.opt, events) ? run.propagated_method(def) : nullptr);
+  Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir,
+                                            needs_partial_steps(run.opt, events, resume ? resume->t : prob.t0, prob.t1)
+                                                ? run.propagated_method(def)
+                                                : nullptr);
   struct CountOnFailure {
     Solution<V>& sol;
     const Recorder<V, SecondOrderProblem<V, F>>& rec;
@@ -671,14 +676,17 @@ void run_gbs(Run<V, F, VE>& run, const MethodDef& def, Solution<V>& sol, const s
   // tolerance 1000 times smaller (bounded by rounding): GBS's accepted steps are usually far more
   // accurate than its tolerance (the estimate is that of the column before the accepted one), and a
   // partial step must not be less accurate than the steps it lies between.
-  GbsOptions gp = go;
-  gp.rtol = std::max(go.rtol * 1e-3, 100 * as_double(epsilon_of<R>()));
-  gp.atol = std::max(go.atol * 1e-3, 100 * as_double(epsilon_of<R>()));
-  GbsIntegrator<VE, typename Run<V, F, VE>::Force> gpart(run.force(), gp);
-  if constexpr (Run<V, F, VE>::td) gpart.set_clock(run.n, sgn_mul(dir, prob.t1));
+  auto partial_step = [&] {
+    GbsOptions gp = go;
+    gp.rtol = std::max(go.rtol * 1e-3, 100 * as_double(epsilon_of<R>()));
+    gp.atol = std::max(go.atol * 1e-3, 100 * as_double(epsilon_of<R>()));
+    GbsIntegrator<VE, typename Run<V, F, VE>::Force> gpart(run.force(), gp);
+    if constexpr (Run<V, F, VE>::td) gpart.set_clock(run.n, sgn_mul(dir, prob.t1));
+    return run.partial_step(std::move(gpart));
+  };
   Recorder<V, SecondOrderProblem<V, F>> rec(
       prob, run.opt, events, sol, dir,
-      needs_partial_steps(run.opt, events) ? run.partial_step(std::move(gpart)) : nullptr);
+      needs_partial_steps(run.opt, events, resume ? resume->t : prob.t0, prob.t1) ? partial_step() : nullptr);
   if (resume) {
     if (resume->engine != "gbs") throw invalid_input("checkpoint of another engine (" + resume->engine + ")");
     run.restore(*resume, s);
@@ -844,6 +852,11 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
                         opt.checkpoint_problem + "')");
   if (resume && resume->method != def.info.name)
     throw invalid_input("the checkpoint was taken with method '" + resume->method + "', not '" + def.info.name + "'");
+  // A resumed run starts at the checkpoint's time: it has no state for an output time before it.
+  if (resume && !opt.t_eval.empty() && sgn_mul(dir, R(opt.t_eval.front())) < sgn_mul(dir, resume->t))
+    throw invalid_input("output time " + adaptive_detail::sci(opt.t_eval.front()) +
+                        " lies before the checkpoint's time " + adaptive_detail::sci(as_double(resume->t)) +
+                        ", where the resumed run starts");
   if (prob.t1 == prob.t0) {
     Recorder<V, P> rec(prob, opt, events, sol, dir, {});
     rec.start(prob.t0, prob.q0, prob.v0);
