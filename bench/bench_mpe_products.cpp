@@ -9,7 +9,7 @@
 //   concurrent-Pt   products on all threads (the force of each product on its own thread)
 //
 // and prints the speedups of concurrent-Pt over the other two. All three give bitwise the same state
-// (checked before timing; tests/test_mpe_schedule.cpp asserts it). --quick: N = 2000.
+// (checked before timing; tests/engines/test_mpe_schedule.cpp asserts it). --quick: N = 2000.
 //
 //   bench_mpe_products [--benchmark_repetitions=3]
 #include <benchmark/benchmark.h>

@@ -37,6 +37,7 @@ status is 1 when a survivor is not listed as equivalent.
 """
 
 import argparse
+import glob
 import json
 import os
 import random
@@ -506,8 +507,8 @@ def main():
     rc, _ = run(cfg, log)
     if rc != 0:
         raise SystemExit(f"mutants: cmake failed (log: {log_path})")
-    available = set(n[:-4] for n in os.listdir(os.path.join(src, "tests")) if n.startswith("test_") and
-                    n.endswith(".cpp")) - set(args.without.split(","))
+    available = set(os.path.basename(n)[:-4] for n in glob.glob(os.path.join(src, "tests", "*", "test_*.cpp"))) - set(
+        args.without.split(","))
 
     def build_targets(targets):
         return run(["cmake", "--build", obj, "-j", str(args.jobs), "--target", *targets], log)[0] == 0

@@ -337,7 +337,7 @@ using quad_double = qd_number<::qd_real>;
 //     r2^(-3/2) = y^3 (1 - e)^(-3/2) = y^3 (1 + 3/2 e + 15/8 e^2 + O(e^3)),   |e| < 2^-50,
 // with y^3 exact to about 2^-106 (two exact products): one correction takes the seed's 53 bits to
 // double-double accuracy. Quad-double takes the double-double value of r2^(-1/2) as its seed and
-// applies the same correction in quad-double (|e| about 2^-104). tests/test_precision.cpp checks
+// applies the same correction in quad-double (|e| about 2^-104). tests/core/test_precision.cpp checks
 // both against MPFR. Outside 2^-600 <= r2 <= 2^600 (and for 0, negative, infinite or NaN r2) they
 // fall back to the generic formula, where the seed's powers could leave the range of double.
 

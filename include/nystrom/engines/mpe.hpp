@@ -229,7 +229,7 @@ class MpeStepper {
   // The unrolled fixed-K loops pay off where a force is a short chain of hardware float operations
   // whose latency the processor can overlap across products: std::array states of float or double.
   // Other scalars (long double, complex, float128, dd, qd, MPFR) run the same lockstep order through
-  // advance_lockstep with a run-time product count, bitwise the same (tests/test_mpe_schedule.cpp),
+  // advance_lockstep with a run-time product count, bitwise the same (tests/engines/test_mpe_schedule.cpp),
   // without 16 more instantiations of the engine per state type and force (compile time).
   static constexpr bool fixed_lockstep =
       is_std_array<V>::value && (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>);

@@ -17,7 +17,7 @@
 // The coefficients are the published decimals (39 to 40 significant digits; the kick weights of SABA(8,6,4) sum
 // to 1 - 5.0e-31 only, so they count as 30 digits); each list below is the first half of a palindrome in time
 // order (the middle coefficient, where the count is odd, is the last one listed).
-// tests/test_planetary.cpp checks their sums, and the measured error structure on a two-planet system.
+// tests/planetary/test_planetary.cpp checks their sums, and the measured error structure on a two-planet system.
 #pragma once
 
 #include <cstddef>

@@ -21,7 +21,7 @@
 // Wanner, Geometric Numerical Integration, 2nd ed. (2006), Sec. V.3.2 (eqs 3.11, 3.12, 3.14 and the
 // p10s35 table; also Hairer's gni_comp.f, METHC=67 for Yoshida's solution A) and OrdinaryDiffEq.jl
 // (symplectic_tableaus.jl: KahanLi6, KahanLi8, SofSpa10). Every table is checked against the
-// composition order conditions in tests/test_catalog_splitting.cpp (local error of the composed
+// composition order conditions in tests/methods/test_catalog_splitting.cpp (local error of the composed
 // splitting on generic non-commuting matrices: observed order p+1, defect at p+1 nonzero).
 //
 // On the two nine-stage sixth-order sets in circulation: Kahan & Li's s9odr6a (gamma_1 =

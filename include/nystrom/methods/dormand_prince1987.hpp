@@ -7,7 +7,7 @@
 // rows satisfy sum_j a_ij = c_i^2 / 2). The digits below were transcribed as exact "p/q" strings
 // and cross-checked against OrdinaryDiffEq.jl, lib/OrdinaryDiffEqRKN/src/rkn_tableaus.jl
 // (DPRKN12Tableau, which stores the embedded weights as differences b - bhat); the proof that they
-// are right is tests/test_dp12.cpp: every order condition of order <= 12 holds to rounding at 256
+// are right is tests/methods/test_dp12.cpp: every order condition of order <= 12 holds to rounding at 256
 // bits for (b, B), and of order <= 10 for (bhat, Bhat).
 //
 // Catalog entries:

@@ -12,7 +12,8 @@
 // with rational r_k. To first order in eps, Z(-alpha, -beta) Z(alpha, beta) = 1 - 2 beta (B(alpha) - B(-alpha)),
 // B(a) = e^{a h A} B e^{-a h A}, an odd series in alpha; an order-n corrector (m = (n - 1) / 2 pairs,
 // m = 8 for n = 17) fixes the odd moments sum_k r_k k^{2j+1} for j < m. The rationals below reproduce the
-// published 50-digit values to 1e-52; the moments they share agree between the orders (tests/test_planetary.cpp).
+// published 50-digit values to 1e-52; the moments they share agree between the orders
+// (tests/planetary/test_planetary.cpp).
 #pragma once
 
 #include <stdexcept>

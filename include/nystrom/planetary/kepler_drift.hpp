@@ -30,7 +30,7 @@
 // |F| 64-fold (Laguerre steps reduce it far more near a root), the G-functions evaluated afresh at every iterate;
 // where they overflow (a far guess on a hyperbola) the bracket shrinks on the side of s and the search goes on.
 // No state is kept between drifts: the path and the result depend on the arguments only, and kepler_drift_many
-// gives every orbit the bits kepler_drift gives it (tests/test_planetary.cpp).
+// gives every orbit the bits kepler_drift gives it (tests/planetary/test_planetary.cpp).
 //
 // Cost (bench/bench_planetary.cpp, outer solar system's Jacobi orbits, h = 50..400 days, GCC 12 -O3): the short
 // path takes every drift there, with one Stumpff evaluation where the general path needs two or three and no
