@@ -28,8 +28,8 @@
 #include "nystrom/analysis/bch.hpp"
 #include "nystrom/analysis/bch_report.hpp"
 #include "nystrom/analysis/method_file.hpp"
-#include "nystrom/methods/mpe_coefficients.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/methods/mpe_coefficients.hpp"
 #include "nystrom/problems/plummer.hpp"
 #include "solve_binding.hpp"
 #ifdef NYSTROM_PYTHON_QUANTUM

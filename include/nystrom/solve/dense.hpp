@@ -12,7 +12,7 @@
 // hermite(t) is the cheap alternative: quintic Hermite interpolation between step ends from q, v and
 // a = q'' at both ends (one force evaluation per step end, none per call). Its local error is O(h^6) in
 // q and O(h^5) in v whatever the method, so it spoils the methods of order 8 and more and the long steps
-// of the adaptive ones: on Kepler e = 0.5 (tests/test_dense.cpp) sol(t) is within 1.2x of the step-end
+// of the adaptive ones: on Kepler e = 0.5 (tests/solve/test_dense.cpp) sol(t) is within 1.2x of the step-end
 // error for every catalog method, the Hermite interpolant 25x to 70x for the order-8 ones (M8, KL8)
 // and 1e6 x between the steps of DP12-adaptive at rtol 1e-10. It is meant for plots.
 #pragma once
