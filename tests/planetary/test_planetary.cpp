@@ -641,6 +641,23 @@ TEST(WisdomHolman, BoundedEnergyOnTheOuterSolarSystem) {
   EXPECT_LT(second, 1.5 * first);  // no secular growth
 }
 
+TEST(PlanetarySystem, EveryBodyIsValidatedTheCentralOneToo) {
+  // A bad mass, position or velocity is refused wherever it stands, body 0 (the central body) included.
+  for (std::size_t body : {std::size_t(0), std::size_t(2)}) {
+    SCOPED_TRACE(body);
+    PlanetarySystem<double> sys = outer_solar_system<double>();
+    EXPECT_NO_THROW(sys.validate());
+    sys.mass[body] = 0;
+    EXPECT_THROW(sys.validate(), std::invalid_argument);
+    sys = outer_solar_system<double>();
+    sys.x[body][1] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THROW(sys.validate(), std::invalid_argument);
+    sys = outer_solar_system<double>();
+    sys.v[body][2] = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(sys.validate(), std::invalid_argument);
+  }
+}
+
 TEST(WisdomHolman, RefusesComplexAndUnknownMethods) {
   const PlanetarySystem<double> s = two_planets(1e-3);
   EXPECT_THROW((void)propagate(s, "WH-BC1", 0.1, 10), std::invalid_argument);
