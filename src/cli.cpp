@@ -148,9 +148,6 @@ ParsedApp make_app() {
   return p;
 }
 
-// One line: the first line of a multi-line message, printable.
-std::string one_line(const std::string& msg) { return printable(msg); }
-
 }  // namespace
 
 Invocation parse_command_line(int argc, const char* const* argv, std::ostream& help_out) {
@@ -181,7 +178,7 @@ int run_main(int argc, char** argv) {
   install_signal_handlers();
   auto fail = [](const std::string& msg) {
     std::cout.flush();
-    std::cerr << "nystrom: error: " << one_line(msg) << "\n";
+    std::cerr << error_line(msg);
     return 2;
   };
   try {

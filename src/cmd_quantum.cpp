@@ -126,7 +126,7 @@ class MpiSession {
   [[noreturn]] void refuse([[maybe_unused]] const std::string& why) const {
 #ifdef NYSTROM_HAVE_MPI
     if (rank_ == 0) {
-      const std::string line = "nystrom: error: " + why + "\n";
+      const std::string line = nystrom::cli::error_line(why);
       if (::write(STDERR_FILENO, line.data(), line.size()) < 0) {
         // nothing more to report with
       }
@@ -141,7 +141,7 @@ class MpiSession {
   void fail([[maybe_unused]] const std::string& why) const {
 #ifdef NYSTROM_HAVE_MPI
     if (active_ && size_ > 1) {
-      const std::string line = "nystrom: error: MPI rank " + std::to_string(rank_) + ": " + why + "\n";
+      const std::string line = nystrom::cli::error_line("MPI rank " + std::to_string(rank_) + ": " + why);
       const int fd = rank_ == 0 ? STDERR_FILENO : err_;
       if (fd >= 0 && ::write(fd, line.data(), line.size()) < 0) {
         // nothing more to report with
