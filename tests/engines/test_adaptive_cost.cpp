@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "nystrom/engines/adaptive_mpe.hpp"
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/method_data.hpp"
@@ -287,6 +288,83 @@ TEST(AdaptiveController, StepSequenceLandsOnTheEndAndStretchesTheLastPercent) {
   EXPECT_TRUE(seq.after_rejection());
   ASSERT_TRUE(seq.next<false>(0.0, h, last));
   EXPECT_DOUBLE_EQ(h, 0.54 * 0.45);
+}
+
+// The step carried into the next call after the last step of a call: the controller's new proposal when the last
+// step was the proposal itself, the earlier proposal when the last step was shortened to land on t1 (its length
+// says nothing about the step the solution allows).
+TEST(AdaptiveController, TheStepCarriedPastTheEndIsTheNewProposalUnlessTheLastStepWasShortened) {
+  const AdaptiveOptions opt{.h0 = 0.5};
+  AdaptiveResumePoint<double> none;
+  double h, carried = 0;
+  bool last;
+  // From 0.5 the proposal 0.5 lands on 1 exactly: accepted with q = 1/2, the next proposal is 0.9 * 0.5 * 0.5.
+  adaptive_detail::StepSequence<double> full(opt, none, carried, 0.0, 1.0, [](const double&) { return 0.0; });
+  ASSERT_TRUE(full.next<true>(0.5, h, last));
+  EXPECT_TRUE(last);
+  EXPECT_EQ(h, 0.5);
+  full.accepted(0.5, h, last, carried);
+  EXPECT_DOUBLE_EQ(carried, 0.225);
+  // From 0.6 the step is shortened to 0.4: accepted with q = 2 (a proposal of 0.72), it carries the earlier 0.5.
+  adaptive_detail::StepSequence<double> cut(opt, none, carried, 0.0, 1.0, [](const double&) { return 0.0; });
+  ASSERT_TRUE(cut.next<true>(0.6, h, last));
+  EXPECT_TRUE(last);
+  EXPECT_DOUBLE_EQ(h, 0.4);
+  cut.accepted(2.0, h, last, carried);
+  EXPECT_EQ(carried, 0.5);
+  // Not the last step: the new proposal, whatever its length.
+  adaptive_detail::StepSequence<double> mid(opt, none, carried, 0.0, 1.0, [](const double&) { return 0.0; });
+  ASSERT_TRUE(mid.next<true>(0.0, h, last));
+  EXPECT_FALSE(last);
+  mid.accepted(0.5, h, last, carried);
+  EXPECT_DOUBLE_EQ(carried, 0.225);
+}
+
+// Order control's choice of the next number of products on known step ratios, with the work A_n = n + 3 per step
+// of n products: the work per unit step W = A / ratio, lower when W_{j-1} < 0.7 W_j, higher (step ratio
+// fj A_{j+1} / A_j, at most fac_max) when W_j < W_{j-1} after an accepted step that followed no rejection,
+// HNW I, eqs (9.25)-(9.28). The thresholds are checked on both sides.
+TEST(AdaptiveController, OrderControlChoosesTheLeastWorkPerUnitStep) {
+  std::vector<double> work(10, 0.0);
+  for (std::size_t n = 1; n < work.size(); ++n) work[n] = static_cast<double>(n) + 3;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto choose = [&](int j, double fj, double fl, bool accepted = true, bool after_rejection = false) {
+    return adaptive_detail::choose_products(j, fj, fl, work, 8, accepted, after_rejection, 4.0);
+  };
+  // j = 5: W_5 = 8 / fj, W_4 = 7 / fl; with fj = 1 the order drops for fl > 7 / 5.6 = 1.25.
+  auto c = choose(5, 1.0, 1.3);
+  EXPECT_EQ(c.next, 4);
+  EXPECT_EQ(c.fac, 1.3);
+  c = choose(5, 1.0, 1.2);
+  EXPECT_EQ(c.next, 5);
+  EXPECT_EQ(c.fac, 1.0);
+  c = choose(5, 1.0, 1.3, false);  // a rejected step lowers the order too
+  EXPECT_EQ(c.next, 4);
+  // fj = 2: W_5 = 4 < W_4 = 7 / 1.2: up, with the ratio 2 * 9 / 8; and W_5 just above W_4: stays.
+  c = choose(5, 2.0, 1.2);
+  EXPECT_EQ(c.next, 6);
+  EXPECT_DOUBLE_EQ(c.fac, 2.25);
+  c = choose(5, 2.0, 1.7);  // W_4 = 4.12 > 4: up
+  EXPECT_EQ(c.next, 6);
+  c = choose(5, 2.0, 1.8);  // W_4 = 3.89 < 4 but not below 0.7 W_5 = 2.8: stays
+  EXPECT_EQ(c.next, 5);
+  EXPECT_EQ(c.fac, 2.0);
+  // Never up after a rejection, after a rejected step, or past the largest number of products.
+  EXPECT_EQ(choose(5, 2.0, 1.2, true, true).next, 5);
+  EXPECT_EQ(choose(5, 2.0, 1.2, false).next, 5);
+  EXPECT_EQ(choose(8, 2.0, 1.2).next, 8);
+  // The ratio of the step up is capped at fac_max: 3.9 * 9 / 8 = 4.39 -> 4.
+  c = choose(5, 3.9, 1.0);
+  EXPECT_EQ(c.next, 6);
+  EXPECT_EQ(c.fac, 4.0);
+  // No estimate of the lower order (two products, or a non-finite one): up only at fac_max.
+  c = choose(2, 4.0, nan);
+  EXPECT_EQ(c.next, 3);
+  EXPECT_EQ(c.fac, 4.0);
+  c = choose(2, 3.9, nan);
+  EXPECT_EQ(c.next, 2);
+  EXPECT_EQ(c.fac, 3.9);
+  EXPECT_EQ(choose(4, 0.5, nan, false).next, 4);
 }
 
 TEST(AdaptiveCost, NearRoundingTheStepsFollowTheOrderNotTheNoise) {

@@ -405,3 +405,58 @@ TEST(AdaptiveMpeOrderControl, StateTypesAgree) {
     EXPECT_EQ(s.v[i], a.s.v[i]);
   }
 }
+
+// The first step of an order-controlled run takes the number of products of ODEX's rule for the first order (HNW I,
+// sec. II.9), floor(-0.6 log10(tol) + 1.5), between three and the largest: written out here per tolerance.
+TEST(AdaptiveMpeOrderControl, FirstStepProductsFollowOdexsRule) {
+  long calls = 0;
+  const std::vector<std::pair<double, int>> rule = {{1e-3, 3},  {1e-5, 4},  {1e-7, 5}, {1e-8, 6},
+                                                    {1e-10, 7}, {1e-12, 8}, {1e-14, 8}};
+  for (const auto& [tol, n] : rule) {
+    auto ai = make_adaptive_mpe_integrator<V2>(resolve_method("MPE-adaptive"), CountingKepler{&calls}, with_tol(tol));
+    EXPECT_EQ(ai.initial_products(), n) << tol;
+  }
+  AdaptiveOptions abs_only;
+  abs_only.rtol = 0;
+  abs_only.atol = 1e-10;
+  EXPECT_EQ(make_adaptive_mpe_integrator<V2>(resolve_method("MPE-adaptive"), CountingKepler{&calls}, abs_only)
+                .initial_products(),
+            7);
+  EXPECT_EQ(
+      make_adaptive_mpe_integrator<V2>(resolve_method("mpe-adaptive-max:10"), CountingKepler{&calls}, with_tol(1e-10))
+          .initial_products(),
+      5);
+  EXPECT_EQ(make_adaptive_mpe_integrator<V2>(resolve_method("M10-adaptive"), CountingKepler{&calls}, with_tol(1e-10))
+                .initial_products(),
+            0);
+}
+
+// Order-control tables the engine cannot run are refused, for every number of products from two: a table of the
+// wrong length, or with a coefficient that is not finite.
+TEST(AdaptiveMpeOrderControl, MalformedTablesAreRefusedFromTwoProducts) {
+  const std::vector<long> k = {1, 2, 3, 4};
+  const AdaptiveMpeCoefficients ac = adaptive_mpe_coefficients(k);
+  auto conv = [](const bigcomplex& x) { return to_scalar<double>(x); };
+  const auto base = convert_scheme<double>(velocity_verlet_scheme(), conv);
+  long calls = 0;
+  auto make = [&](MpeOrderTables<double> orders) {
+    return AdaptiveMpeIntegrator<V2, CountingKepler>(k, mpe_coefficients_as<double>(ac.high),
+                                                     mpe_coefficients_as<double>(ac.error()), base,
+                                                     CountingKepler{&calls}, with_tol(1e-8), {}, std::move(orders));
+  };
+  EXPECT_EQ(make(mpe_order_tables<double>(k)).max_products(), 4);
+  for (std::size_t n = 2; n <= 4; ++n) {
+    auto shorter = mpe_order_tables<double>(k);
+    shorter.c[n].pop_back();
+    EXPECT_THROW(make(shorter), std::invalid_argument) << n;
+    auto longer = mpe_order_tables<double>(k);
+    longer.d[n].push_back(0.0);
+    EXPECT_THROW(make(longer), std::invalid_argument) << n;
+    auto nan = mpe_order_tables<double>(k);
+    nan.d[n][0] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THROW(make(nan), std::invalid_argument) << n;
+    auto inf = mpe_order_tables<double>(k);
+    inf.c[n][n - 1] = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(make(inf), std::invalid_argument) << n;
+  }
+}

@@ -14,6 +14,7 @@
 
 #include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
+#include "nystrom/solve/recorder.hpp"
 #include "nystrom/solve/solve.hpp"
 #include "support/kepler.hpp"
 
@@ -602,6 +603,36 @@ TEST(SolveEvents, AnEventCostsTwoForcesAndAboutOneStepOfTheMethodInBothDirection
   }
 }
 
+// The zero finder of the event locator (the Illinois variant of regula falsi) on g(t) = t^3 - 1/8 over the
+// bracket (0, 2), in either order: a first point at the zero costs one evaluation of g, a first point near it fewer
+// than the bracket alone, and a first point at an end of the bracket is not used; each ends within a few units
+// of rounding of the zero 1/2.
+TEST(SolveEvents, TheZeroFinderStartsFromItsFirstPoint) {
+  int calls = 0;
+  const auto g = [&](double t) {
+    ++calls;
+    return t * t * t - 0.125;
+  };
+  const double eps = std::numeric_limits<double>::epsilon();
+  auto zero = [&](bool reversed, double first) {
+    calls = 0;
+    return reversed ? solve_detail::illinois(g, 2.0, 0.0, 7.875, -0.125, first)
+                    : solve_detail::illinois(g, 0.0, 2.0, -0.125, 7.875, first);
+  };
+  for (const bool reversed : {false, true}) {
+    SCOPED_TRACE(reversed ? "bracket (2, 0)" : "bracket (0, 2)");
+    EXPECT_EQ(zero(reversed, 0.5), 0.5);
+    EXPECT_EQ(calls, 1);
+    EXPECT_NEAR(zero(reversed, reversed ? 2.0 : 0.0), 0.5, 4 * eps);
+    const int from_bracket = calls;
+    EXPECT_NEAR(zero(reversed, 0.501), 0.5, 4 * eps);
+    const int from_near = calls;
+    EXPECT_LT(from_near, from_bracket);
+    EXPECT_GE(from_near, 2);
+    EXPECT_LE(from_bracket, 20);  // superlinear convergence, far below the cap of 100 evaluations
+  }
+}
+
 TEST(SolveEvents, TerminalEventEndsTheRunThere) {
   const KeplerProblem<double> kp(0.9);
   const auto prob = kepler(0.9, 0.0, 20.0);
@@ -734,4 +765,37 @@ TEST(SolveCheckpoint, RestartIsBitwiseTheUninterruptedRun) {
   }
   EXPECT_THROW(checkpoint_from_text<double>("nystrom-checkpoint 99\n"), invalid_input);
   EXPECT_THROW(checkpoint_from_text<double>("garbage"), invalid_input);
+}
+
+// A checkpoint whose state has one number too few or too many for the problem is refused with one line, for a
+// real method (q, v) and for a complex one (q, v as real and imaginary parts: a value missing from the last pair).
+TEST(SolveCheckpoint, AStateOfTheWrongSizeIsRefused) {
+  const auto prob = kepler(0.7, 0.0, 3.0);
+  for (const std::string method : {"M8", "Chambers"}) {
+    SCOPED_TRACE(method);
+    const auto def = resolve_solve_method(method);
+    SolveOptions opt{.steps = 300};
+    opt.checkpoint_at = 1.0;
+    opt.checkpoint_problem = "kepler e=0.7";
+    const auto first = solve(prob, def, opt);
+    ASSERT_TRUE(first.checkpoint.has_value());
+    const std::size_t values = method == "M8" ? 4 : 8;
+    ASSERT_EQ(first.checkpoint->state.size(), values);
+    EXPECT_EQ(resume(prob, def, *first.checkpoint, opt).q_final, solve(prob, def, {.steps = 300}).q_final);
+    for (const int change : {-1, 1, -2}) {
+      auto cp = *first.checkpoint;
+      if (change > 0)
+        cp.state.push_back(0.5);
+      else
+        cp.state.resize(cp.state.size() - static_cast<std::size_t>(-change));
+      try {
+        resume(prob, def, cp, opt);
+        ADD_FAILURE() << "a state of " << cp.state.size() << " numbers was accepted";
+      } catch (const invalid_input& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("the state has the wrong size"), std::string::npos) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      }
+    }
+  }
 }

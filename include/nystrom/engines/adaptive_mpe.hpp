@@ -53,6 +53,35 @@
 
 namespace nystrom {
 
+namespace adaptive_detail {
+
+/// The next number of products of order control and its step ratio (HNW I, eqs (9.25)-(9.28), with the orders
+/// of the products in place of the columns): after a step whose solution took j products, with the step ratios
+/// fj of order 2j and fl of order 2j - 2 (NaN when there is no estimate of the lower order) and the work per step
+/// work[n] = A_n, the work per unit step is W = A / ratio; the choice is j - 1 (ratio fl) when W_{j-1} < 0.7 W_j,
+/// else, after an accepted step that did not follow a rejection and below the largest number nmax, j + 1 with the
+/// ratio fj A_{j+1} / A_j (at most fac_max) when W_j < W_{j-1}, or when there is no lower estimate and fj is at
+/// fac_max; else j (ratio fj).
+struct ProductsChoice {
+  int next;
+  double fac;
+};
+inline ProductsChoice choose_products(int j, double fj, double fl, const std::vector<double>& work, int nmax,
+                                      bool accepted, bool after_rejection, double fac_max) {
+  const bool may_grow = accepted && !after_rejection && j < nmax;
+  if (!std::isnan(fl)) {
+    const double wj = work[static_cast<std::size_t>(j)] / fj, wl = work[static_cast<std::size_t>(j - 1)] / fl;
+    if (wl < 0.7 * wj) return {j - 1, fl};
+    if (may_grow && wj < wl)
+      return {j + 1, std::min(fac_max, fj * work[static_cast<std::size_t>(j + 1)] / work[static_cast<std::size_t>(j)])};
+    return {j, fj};
+  }
+  if (may_grow && fj >= fac_max) return {j + 1, fj};
+  return {j, fj};
+}
+
+}  // namespace adaptive_detail
+
 template <class V, class Force>
 class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
  public:
@@ -113,6 +142,15 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   /// Order control: the accepted steps of all calls so far by the order of the solution they propagated
   /// (index: the order 2n; size 2N + 1). Empty for one order per run.
   const std::vector<long>& order_histogram() const { return hist_; }
+  /// Order control: the products of the first step of a run, from the tolerance by ODEX's rule for the first
+  /// order (HNW I, sec. II.9): floor(-0.6 log10(tol) + 1.5), at least min(3, N) and at most N (tol: rtol, or
+  /// atol when rtol is 0). 0 for one order per run.
+  int initial_products() const {
+    if (nmax_ == 0) return 0;
+    const double tol = opt_.rtol > 0 ? opt_.rtol : opt_.atol;
+    const int n = static_cast<int>(-0.6 * std::log10(tol) + 1.5);
+    return std::max(nmin_target(), std::min(nmax_, n));
+  }
   /// Order control: steps rejected after the products of order 2n - 2 alone, before the last pair of the
   /// longest product (their estimate was not finite: the force returned NaN or inf).
   long early_rejections() const { return early_rejected_; }
@@ -392,16 +430,9 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
     for (std::size_t n = 1; n <= N + 1; ++n) work_[n] = static_cast<double>(n) + 3;
   }
 
-  // The first target: ODEX's rule (HNW I, sec. II.9) for the orders of the products.
   // The smallest target: three products (the step can still stop at two), so that every full step has the
   // estimates of two orders to choose from; two when that is the largest.
   int nmin_target() const { return std::min(3, nmax_); }
-
-  int oc_initial_products() const {
-    const double tol = opt_.rtol > 0 ? opt_.rtol : opt_.atol;
-    const int n = static_cast<int>(-0.6 * std::log10(tol) + 1.5);
-    return std::max(nmin_target(), std::min(nmax_, n));
-  }
 
   template <bool Comp, class Observer>
   AdaptiveStats run_oc(State<V>& s_io, real_type t0, real_type t1, Observer& obs) {
@@ -411,7 +442,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
     if (t1 == t0) return st;
 
     const adaptive_detail::ErrorScale<real_type> err_scale(opt_);
-    int nt = n_next_ > 0 ? n_next_ : oc_initial_products();  // the target number of products
+    int nt = n_next_ > 0 ? n_next_ : initial_products();  // the target number of products
     adaptive_detail::StepSequence<real_type> seq(opt_, resume_, h_next_, t0, t1,
                                                  starting_step(s_io, err_scale, 2 * nt));
     std::vector<adaptive_detail::StepController> ctl(static_cast<std::size_t>(nmax_) + 1,
@@ -511,24 +542,11 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
         for (int i = 2; i <= nmax_; ++i)
           if (i != j && i != j - 1) ctl[static_cast<std::size_t>(i)].restore(0, 0);
         const double fj = ctl[static_cast<std::size_t>(j)].accepted(qof(ej, j), hd, after_rej);
-        double fac = fj;
-        int next = j;
-        if (j - 1 >= 2) {
-          const double fl = ctl[static_cast<std::size_t>(j - 1)].accepted(qof(elo, j - 1), hd, after_rej);
-          const double wj = work_[static_cast<std::size_t>(j)] / fj, wl = work_[static_cast<std::size_t>(j - 1)] / fl;
-          if (wl < 0.7 * wj) {
-            next = j - 1;
-            fac = fl;
-          } else if (j < nmax_ && !after_rej && wj < 1.0 * wl) {
-            next = j + 1;
-            fac = std::min(opt_.fac_max,
-                           fj * work_[static_cast<std::size_t>(j + 1)] / work_[static_cast<std::size_t>(j)]);
-          }
-        } else if (j < nmax_ && !after_rej && fj >= opt_.fac_max) {
-          next = j + 1;
-        }
-        nt = std::max(nmin_target(), next);
-        seq.accepted_ratio(fac, h, last, h_next_);
+        const double fl = j - 1 >= 2 ? ctl[static_cast<std::size_t>(j - 1)].accepted(qof(elo, j - 1), hd, after_rej)
+                                     : std::numeric_limits<double>::quiet_NaN();
+        const auto choice = adaptive_detail::choose_products(j, fj, fl, work_, nmax_, true, after_rej, opt_.fac_max);
+        nt = std::max(nmin_target(), choice.next);
+        seq.accepted_ratio(choice.fac, h, last, h_next_);
         if (stop && t < t1) {
           resume_ = seq.resume_point(t);
           break;
@@ -537,17 +555,12 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
         ++rejected;
         if (early_reject) ++early_rejected_;
         const double fj = ctl[static_cast<std::size_t>(j)].rejected(qof(ej, j));
-        double fac = fj;
-        int next = j;
-        if (j - 1 >= 2 && std::isfinite(elo)) {
-          const double fl = ctl[static_cast<std::size_t>(j - 1)].rejected(qof(elo, j - 1));
-          if (work_[static_cast<std::size_t>(j - 1)] / fl < 0.7 * work_[static_cast<std::size_t>(j)] / fj) {
-            next = j - 1;
-            fac = fl;
-          }
-        }
-        nt = std::max(nmin_target(), next);
-        seq.rejected_ratio(fac, h);
+        const double fl = j - 1 >= 2 && std::isfinite(elo)
+                              ? ctl[static_cast<std::size_t>(j - 1)].rejected(qof(elo, j - 1))
+                              : std::numeric_limits<double>::quiet_NaN();
+        const auto choice = adaptive_detail::choose_products(j, fj, fl, work_, nmax_, false, true, opt_.fac_max);
+        nt = std::max(nmin_target(), choice.next);
+        seq.rejected_ratio(choice.fac, h);
       }
     }
     store();

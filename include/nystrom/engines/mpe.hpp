@@ -148,11 +148,11 @@ class MpeStepper {
   void naive_step(State<V>& s, real_type h) {
     first_force(s);
     resize_like(acc_.q, s.q);
-    resize_like(acc_.v, s.q);
+    resize_like(acc_.v, s.v);
     for (auto& e : acc_.q) e = scalar_type(0);
     for (auto& e : acc_.v) e = scalar_type(0);
     for (std::size_t i = 0; i < k_.size(); ++i) {
-      run_product<false>(s, i, h, ti_);
+      run_product(s, i, h, ti_);
       axpy(acc_.q, c_[i], ti_.q);
       axpy(acc_.v, c_[i], ti_.v);
     }
@@ -396,8 +396,7 @@ class MpeStepper {
 #endif
   }
 
-  // Measurements only (naive_step): one product T_2^k_i(h / k_i) from s.
-  template <bool Comp>
+  // Measurements only (naive_step): one product T_2^k_i(h / k_i) from s, uncompensated.
   void run_product(const State<V>& s, std::size_t i, real_type h, State<V>& out) {
     resize_like(out.q, s.q);
     resize_like(out.v, s.v);
@@ -407,16 +406,7 @@ class MpeStepper {
       base_.seed_force(s.q, a0_);
     else
       base_.reset_cache();
-    if constexpr (Comp) {
-      resize_like(pc_.cq, s.q);
-      resize_like(pc_.cv, s.q);
-      for (auto& e : pc_.cq) e = scalar_type(0);
-      for (auto& e : pc_.cv) e = scalar_type(0);
-      base_.integrate_compensated(out, h / static_cast<real_type>(k_[i]), k_[i], pc_);
-      to_increment(s, out, pc_.cq, pc_.cv);
-    } else {
-      base_.integrate(out, h / static_cast<real_type>(k_[i]), k_[i]);
-    }
+    base_.integrate(out, h / static_cast<real_type>(k_[i]), k_[i]);
   }
 
   std::vector<long> k_;

@@ -29,6 +29,35 @@
 namespace nystrom {
 namespace solve_detail {
 
+// The zero of g in the bracket (lo, hi) with g(lo) = ga and g(hi) = gb of opposite signs, by the
+// Illinois variant of regula falsi from a first point `first` (used when strictly inside), to a few
+// units of rounding of t (or 100 evaluations of g).
+template <class R, class G>
+R illinois(G&& gfun, R lo, R hi, R ga, R gb, const R& first) {
+  using std::abs;
+  int side = 0;
+  const R eps = epsilon_of<R>();
+  for (int it = 0; it < 100; ++it) {
+    if (abs(hi - lo) <= R(4) * eps * std::max(abs(lo), abs(hi))) break;
+    R m = (it == 0 && (first - lo) * (hi - first) > R(0)) ? first : R((lo * gb - hi * ga) / (gb - ga));
+    if (!((m - lo) * (hi - m) > R(0))) m = (lo + hi) / R(2);  // strictly inside the bracket
+    const R gm = gfun(m);
+    if (gm == R(0)) return m;
+    if ((gm < R(0)) == (ga < R(0))) {
+      lo = m;
+      ga = gm;
+      if (side == -1) gb /= R(2);
+      side = -1;
+    } else {
+      hi = m;
+      gb = gm;
+      if (side == 1) ga /= R(2);
+      side = 1;
+    }
+  }
+  return abs(ga) < abs(gb) ? lo : hi;
+}
+
 /// Receives every accepted step end (user time and state), keeps the dense output, the saved states
 /// and the events, and says when a terminal event stops the run. Output times and events inside a
 /// step come from the partial step of the method (DenseOutput::PartialStep). An event is bracketed by
@@ -288,34 +317,6 @@ class Recorder {
         tp_, t, ga, gb, te);
     s = interpolate(t, q, v, tz);
     return tz;
-  }
-  // The zero of g in the bracket (lo, hi) with g(lo) = ga and g(hi) = gb of opposite signs, by the
-  // Illinois variant of regula falsi from a first point `first` (used when strictly inside), to a few
-  // units of rounding of t (or 100 evaluations of g).
-  template <class G>
-  static R illinois(G&& gfun, R lo, R hi, R ga, R gb, const R& first) {
-    using std::abs;
-    int side = 0;
-    const R eps = epsilon_of<R>();
-    for (int it = 0; it < 100; ++it) {
-      if (abs(hi - lo) <= R(4) * eps * std::max(abs(lo), abs(hi))) break;
-      R m = (it == 0 && (first - lo) * (hi - first) > R(0)) ? first : R((lo * gb - hi * ga) / (gb - ga));
-      if (!((m - lo) * (hi - m) > R(0))) m = (lo + hi) / R(2);  // strictly inside the bracket
-      const R gm = gfun(m);
-      if (gm == R(0)) return m;
-      if ((gm < R(0)) == (ga < R(0))) {
-        lo = m;
-        ga = gm;
-        if (side == -1) gb /= R(2);
-        side = -1;
-      } else {
-        hi = m;
-        gb = gm;
-        if (side == 1) ga /= R(2);
-        side = 1;
-      }
-    }
-    return abs(ga) < abs(gb) ? lo : hi;
   }
 
   P& prob_;
