@@ -11,6 +11,7 @@
 
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/methods/rkn_order_conditions.hpp"
 #include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 
@@ -219,4 +220,44 @@ TEST(AdaptiveRkn, StepControllerRatios) {
     EXPECT_DOUBLE_EQ(c.rejected(0.0), 0.2);   // err = inf
     EXPECT_DOUBLE_EQ(c.rejected(NAN), 0.2);   // err NaN
   }
+}
+
+// tableau_order caps the order it reports at 14 unless asked for more. A tableau of a higher order: the
+// multi-product expansion of order 16 over the Stormer-Verlet products k = 1..8 (Chin, eq 14: c_i = prod_{j != i}
+// k_i^2 / (k_i^2 - k_j^2)), written as one explicit tableau, the direct sum of the products' tableaux with their
+// weights times c_i.
+TEST(AdaptiveRkn, TableauOrderIsCappedAtFourteenUnlessAskedForMore) {
+  RknTableau<double> t;
+  std::size_t off = 0;
+  for (int ki = 1; ki <= 8; ++ki) {
+    double ci = 1;
+    for (int kj = 1; kj <= 8; ++kj)
+      if (kj != ki) ci *= double(ki * ki) / double(ki * ki - kj * kj);
+    const double h = 1.0 / ki;
+    SplittingScheme<double> vv;  // k_i velocity-Verlet steps of 1 / k_i, kicks of adjacent steps merged
+    vv.steps.push_back({Flow::kick, h / 2});
+    for (int r = 1; r < ki; ++r) {
+      vv.steps.push_back({Flow::drift, h});
+      vv.steps.push_back({Flow::kick, h});
+    }
+    vv.steps.push_back({Flow::drift, h});
+    vv.steps.push_back({Flow::kick, h / 2});
+    const auto p = to_rkn_tableau(vv);
+    const std::size_t s = p.stages(), n = off + s;
+    for (auto& row : t.a) row.resize(n, 0.0);
+    for (std::size_t i = 0; i < s; ++i) {
+      t.c.push_back(p.c[i]);
+      t.b.push_back(ci * p.b[i]);
+      t.B.push_back(ci * p.B[i]);
+      std::vector<double> row(n, 0.0);
+      for (std::size_t j = 0; j < i; ++j) row[off + j] = p.a[i][j];
+      t.a.push_back(row);
+    }
+    off = n;
+  }
+  t.validate();
+  EXPECT_EQ(t.stages(), 44u);
+  EXPECT_EQ(tableau_order(t), 14);
+  EXPECT_EQ(tableau_order(t, 15), 15);
+  EXPECT_EQ(tableau_order(t, 10), 10);
 }

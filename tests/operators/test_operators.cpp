@@ -185,6 +185,22 @@ TEST(Applicability, ClassicalOnlyMethodsAreRefusedWithTheReason) {
   EXPECT_THROW((void)resolve_flow_method("mpe4:1,1", OperatorStructure::rkn, 53, "double"), std::invalid_argument);
 }
 
+// The forward methods named in refusals: Chin's 4A only where its gradient term exists and is asked for (a
+// kinetic-potential pair, whose double commutator is a function), the multi-product expansions everywhere, the
+// complex RKN splittings only for kinetic-potential pairs.
+TEST(Applicability, ForwardAlternativesNameOnlyMethodsThatApply) {
+  const std::string rkn_grad = forward_alternatives(OperatorStructure::rkn, true);
+  const std::string rkn = forward_alternatives(OperatorStructure::rkn, false);
+  const std::string general = forward_alternatives(OperatorStructure::general, true);
+  EXPECT_NE(rkn_grad.find("Chin's 4A"), std::string::npos) << rkn_grad;
+  EXPECT_EQ(rkn.find("4A"), std::string::npos) << rkn;
+  EXPECT_EQ(general.find("4A"), std::string::npos) << general;
+  for (const auto& s : {rkn_grad, rkn, general}) EXPECT_NE(s.find("multi-product M4..M"), std::string::npos) << s;
+  EXPECT_NE(rkn.find("AC1"), std::string::npos) << rkn;
+  EXPECT_EQ(general.find("AC1"), std::string::npos) << general;
+  EXPECT_EQ(rkn_grad.find('\n'), std::string::npos);
+}
+
 TEST(OperatorOrder, EveryApplicableCatalogMethod) {
   int tested = 0;
   for (const auto& def : catalog()) {

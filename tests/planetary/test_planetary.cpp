@@ -761,3 +761,18 @@ TEST(GeneralizedOrder, ErrorTermsInThePerturbationAndTheStep) {
     EXPECT_NEAR(std::log2(hi / lo), c.eps_power, 0.4);
   }
 }
+
+// The total angular momentum sum m_i x_i cross v_i of two bodies with every component nonzero, computed by hand:
+// 2 (1, 2, 3) x (4, 5, 6) = (-6, 12, -6) and 3 (-1, 1/2, 2) x (1/4, -2, 1) = (27/2, 9/2, 45/8).
+TEST(PlanetarySystem, AngularMomentumOfTwoBodiesByHand) {
+  const std::vector<double> mass = {2, 3};
+  const std::vector<Vec3<double>> x = {{1, 2, 3}, {-1, 0.5, 2}}, v = {{4, 5, 6}, {0.25, -2, 1}};
+  const Vec3<double> l = angular_momentum(mass, x, v);
+  EXPECT_EQ(l[0], 7.5);
+  EXPECT_EQ(l[1], 16.5);
+  EXPECT_EQ(l[2], -0.375);
+  const Vec3<double> one = angular_momentum(std::vector<double>{2}, x, v);
+  EXPECT_EQ(one[0], -6);
+  EXPECT_EQ(one[1], 12);
+  EXPECT_EQ(one[2], -6);
+}

@@ -279,6 +279,37 @@ TEST(Smoluchowski, PotentialValuesGiveTheBuiltInResult) {
   }
 }
 
+// The reported mass, mean and variance are those of the kept density, the moments per unit mass: at a step where
+// the mass drifts measurably (so that dividing by the mass and multiplying by it differ), computed here from the
+// density itself.
+TEST(Smoluchowski, MomentsAreThoseOfTheKeptDensityPerUnitMass) {
+  SmoluchowskiProblem<double> p;
+  p.grid = 64;
+  p.box = 6;
+  p.x0 = {-1.0};
+  p.width = 0.2;
+  p.keep_density = true;
+  const auto r = smoluchowski(p, "M8", 0.05, 200);
+  ASSERT_EQ(r.density.size(), 64u);
+  const Grid<double> g(1, 64, 6.0);
+  double mass = 0, m1 = 0, m2 = 0;
+  for (int i = 0; i < 64; ++i) {
+    const double x = g.coordinate(i), w = r.density[static_cast<std::size_t>(i)] * g.dx();
+    mass += w;
+    m1 += x * w;
+    m2 += x * x * w;
+  }
+  const double mean = m1 / mass, var = m2 / mass - mean * mean;
+  std::printf("mass %.9f, mean %.9f, variance %.9f\n", mass, mean, var);
+  ASSERT_GT(std::abs(mass - 1), 1e-6) << "the mass must drift for this test to tell the moments apart";
+  EXPECT_NEAR(r.mass, mass, 1e-13);
+  EXPECT_NEAR(r.mass_drift, mass - 1, 1e-13);
+  ASSERT_EQ(r.mean.size(), 1u);
+  ASSERT_EQ(r.variance.size(), 1u);
+  EXPECT_NEAR(r.mean[0], mean, 1e-12);
+  EXPECT_NEAR(r.variance[0], var, 1e-12);
+}
+
 TEST(Smoluchowski, BadInputIsRefused) {
   auto refused = [](auto change, const std::string& words) {
     SmoluchowskiProblem<double> p = ou_problem();
@@ -348,6 +379,25 @@ TEST(Thermal, ExtrapolatedPropagatorsConvergeAtTheirOrder) {
       EXPECT_NEAR(pz, 2.0 * static_cast<double>(seq.size()), 0.3) << potential << " " << lz;
       EXPECT_NEAR(pe, 2.0 * static_cast<double>(seq.size()), 0.3) << potential << " " << le;
       EXPECT_EQ(r.order, 2 * static_cast<int>(seq.size()));
+    }
+  }
+}
+
+// The Jacobi eigenvalues behind the exact partition function are those of the second-difference matrix
+// (2 - 2 cos(k pi / (n + 1))), at every scale of the matrix: the stopping test is relative to its norm.
+TEST(Thermal, JacobiEigenvaluesAtEveryScale) {
+  constexpr std::size_t n = 6;
+  for (const double scale : {1e-20, 1.0, 1e20}) {
+    quantum::detail::Matrix<double> m(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      m(i, i) = 2 * scale;
+      if (i + 1 < n) m(i, i + 1) = m(i + 1, i) = -scale;
+    }
+    const auto e = quantum::detail::symmetric_eigenvalues(m);
+    ASSERT_EQ(e.size(), n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double exact = scale * (2 - 2 * std::cos(static_cast<double>(k + 1) * std::numbers::pi / (n + 1)));
+      EXPECT_NEAR(e[k], exact, 1e-14 * scale) << "scale " << scale << ", eigenvalue " << k;
     }
   }
 }

@@ -643,3 +643,46 @@ TEST(QuantumSolve, AHeartbeatNeedsItsCadence) {
   solve(p, "Y4", 0.05, 4);
   EXPECT_EQ(beats, 2);
 }
+
+// Each named potential of the grid is the formula its documentation gives, at points off every axis in one to three
+// dimensions (computed here from the formulas, not from the solver).
+TEST(QuantumGrid, NamedPotentialsAreTheirDocumentedFormulas) {
+  const std::vector<std::vector<double>> points = {{0.7}, {-1.3, 0.4}, {0.3, -0.8, 1.1}};
+  for (const auto& x : points) {
+    const int d = static_cast<int>(x.size());
+    double r2 = 0, aniso = 0, morse = 0;
+    for (int j = 0; j < d; ++j) {
+      r2 += x[j] * x[j];
+      aniso += (j + 1) * x[j] * x[j] / 2;  // w_j^2 = j + 1
+      const double e = 1 - std::exp(-x[j] / 2);
+      morse += 8 * e * e;
+    }
+    const double well = (x[0] * x[0] - 1) * (x[0] * x[0] - 1) + (r2 - x[0] * x[0]) / 2;
+    const std::vector<std::pair<std::string, double>> expected = {
+        {"harmonic", r2 / 2},  {"anisotropic", aniso}, {"morse", morse},
+        {"double-well", well}, {"free", 0.0},          {"soft-coulomb", -1 / std::sqrt(r2 + 1)}};
+    ASSERT_EQ(expected.size(), potential_names().size());
+    for (const auto& [name, v] : expected)
+      EXPECT_NEAR(named_potential<double>(name)(x.data(), d), v, 1e-15 * (1 + std::abs(v))) << name << " in " << d;
+  }
+  EXPECT_THROW(named_potential<double>("quartic"), std::invalid_argument);
+}
+
+// The observables of a wave function that is zero everywhere are zero, not 0/0: the norm, the energies, the
+// chemical potential and the means.
+TEST(QuantumDiagnostics, AZeroWaveFunctionHasZeroObservables) {
+  for (const int dims : {1, 2}) {
+    const Grid<double> g(dims, 16, 8.0);
+    SchrodingerFlows<double> flows(g, sample_potential(g, named_potential<double>("harmonic")), TimeKind::real);
+    const Field<double> psi(g.size(), std::complex<double>(0, 0));
+    const auto o = observe(flows, psi);
+    EXPECT_EQ(o.norm, 0.0);
+    EXPECT_EQ(o.energy, 0.0);
+    EXPECT_EQ(o.chemical_potential, 0.0);
+    EXPECT_EQ(o.kinetic, 0.0);
+    EXPECT_EQ(o.potential, 0.0);
+    EXPECT_EQ(o.interaction, 0.0);
+    EXPECT_EQ(o.mean_x, std::vector<double>(static_cast<std::size_t>(dims), 0.0));
+    EXPECT_EQ(o.mean_p, std::vector<double>(static_cast<std::size_t>(dims), 0.0));
+  }
+}

@@ -97,6 +97,24 @@ TEST(SolveDirections, FixedStepsTakeTheSameStepsBothWays) {
   }
 }
 
+// A span that is a whole number of steps up to rounding (3 x 0.1 = 0.30000000000000004, and that over 0.1 is
+// 3.0000000000000004) takes that number of steps, with no sliver of a fourth, in either direction.
+TEST(SolveDirections, ASpanOfWholeStepsUpToRoundingTakesNoSliverStep) {
+  const double span = 3 * 0.1;
+  ASSERT_GT(span / 0.1, 3.0);
+  for (int dir : {1, -1}) {
+    SCOPED_TRACE(dir);
+    const double t0 = dir > 0 ? 0.0 : span, t1 = dir > 0 ? span : 0.0;
+    const auto sol =
+        solve(SecondOrderProblem(oscillator, Vd{std::cos(t0)}, Vd{-std::sin(t0)}, t0, t1), "M8", {.h = 0.1});
+    EXPECT_EQ(sol.accepted, 3);
+    ASSERT_EQ(sol.t.size(), 4u);
+    for (std::size_t i = 1; i < 4; ++i) EXPECT_NEAR(std::abs(sol.t[i] - sol.t[i - 1]), 0.1, 1e-15) << i;
+    EXPECT_EQ(sol.t_final, t1);
+    expect_exact(sol.t_final, sol.q_final[0], sol.v_final[0], 1e-12);
+  }
+}
+
 TEST(SolveDirections, DenseOutputHasTheAnalyticPositionsAndVelocitiesInsideTheSteps) {
   for (int dir : {1, -1}) {
     for (const std::string m : {"M8", "FR", "DP12-adaptive"}) {
