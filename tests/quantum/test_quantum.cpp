@@ -9,6 +9,7 @@
 #include <complex>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -684,5 +685,61 @@ TEST(QuantumDiagnostics, AZeroWaveFunctionHasZeroObservables) {
     EXPECT_EQ(o.interaction, 0.0);
     EXPECT_EQ(o.mean_x, std::vector<double>(static_cast<std::size_t>(dims), 0.0));
     EXPECT_EQ(o.mean_p, std::vector<double>(static_cast<std::size_t>(dims), 0.0));
+  }
+}
+
+// The Gross-Pitaevskii equation in real time conserves the energy <T + V> + (g/2) int |psi|^4 and the norm; in
+// imaginary time M8 and M6 reach the same chemical potential, above the oscillator's 1/2; a complex-coefficient
+// method is refused for g != 0 in either time (|psi|^2 is not analytic: such a method converges at first order).
+TEST(GrossPitaevskii, RealTimeEnergyAndImaginaryTimeChemicalPotential) {
+  auto p = coherent_1d();
+  p.g = 4;
+  const auto start = solve(p, "M6", 1e-5, 1);
+  const auto later = solve(p, "M6", 0.005, 600);
+  std::printf("GPE real time: energy %.12f at the start, %.12f at t = 3; norm drift %.2e\n", start.energy, later.energy,
+              later.norm_drift);
+  EXPECT_NEAR(later.energy, start.energy, 1e-8 * std::abs(start.energy));
+  EXPECT_LT(std::abs(later.norm_drift), 1e-12);
+  auto free = p;
+  free.g = 0;
+  EXPECT_GT(std::abs(solve(free, "M6", 1e-5, 1).energy - start.energy), 0.1);  // the interaction counts
+  p.time = TimeKind::imaginary;
+  p.g = 2;
+  const auto real = solve(p, "M8", 0.01, 1500);
+  const auto m6 = solve(p, "M6", 0.02, 750);
+  std::printf("GPE ground state: mu %.12f (M8), %.12f (M6)\n", real.chemical_potential, m6.chemical_potential);
+  EXPECT_NEAR(m6.chemical_potential, real.chemical_potential, 1e-10);
+  EXPECT_GT(real.chemical_potential, 0.5 + 0.1);  // above the oscillator's 1/2: repulsion
+  for (const TimeKind time : {TimeKind::imaginary, TimeKind::real})
+    for (const std::string m : {"BC1", "AC1"}) {
+      p.time = time;
+      try {
+        solve(p, m, 0.01, 10);
+        ADD_FAILURE() << m << " accepted for g != 0";
+      } catch (const invalid_input& e) {
+        EXPECT_NE(std::string(e.what()).find("Gross-Pitaevskii"), std::string::npos) << e.what();
+      }
+    }
+}
+
+// A Gaussian packet of width s: (pi s^2)^(-1/4) e^{-(x - x0)^2 / (2 s^2) + i p0 x}, normalised, with mean x0 and
+// variance s^2 / 2, for widths other than the coherent state's 1.
+TEST(QuantumGrid, GaussianPacketOfAnyWidth) {
+  const Grid<double> g(1, 256, 24.0);
+  for (const double s : {0.5, 1.0, 1.7}) {
+    const auto psi = gaussian_packet<double>(g, {0.3}, {0.8}, s);
+    double n = 0, m1 = 0, m2 = 0;
+    for (int i = 0; i < 256; ++i) {
+      const double x = g.coordinate(i), rho = std::norm(psi[static_cast<std::size_t>(i)]);
+      n += rho * g.dx();
+      m1 += x * rho * g.dx();
+      m2 += x * x * rho * g.dx();
+      const std::complex<double> z = std::pow(std::numbers::pi * s * s, -0.25) *
+                                     std::exp(std::complex<double>(-(x - 0.3) * (x - 0.3) / (2 * s * s), 0.8 * x));
+      EXPECT_NEAR(std::abs(psi[static_cast<std::size_t>(i)] - z), 0.0, 1e-15) << s << " at " << x;
+    }
+    EXPECT_NEAR(n, 1.0, 1e-13) << s;
+    EXPECT_NEAR(m1, 0.3, 1e-13) << s;
+    EXPECT_NEAR(m2 - 0.09, s * s / 2, 1e-12) << s;
   }
 }

@@ -431,11 +431,35 @@ TEST(QuantumMpi, TwoRanksGiveTheOneProcessResult) {
       "quantum --dims 3 --grid 16 --box 12 --method M4 --dt 0.1 --steps 10 --x0 1,0.5 --p0 0,0,0.5 "
       "--json");
   expect_same_result(
-      "quantum --dims 2 --grid 45 --box 14 --method BC1 --dt 0.1 --steps 20 --imaginary-time --g 2 "
+      "quantum --dims 2 --grid 45 --box 14 --method M6 --dt 0.1 --steps 20 --imaginary-time --g 2 "
       "--x0 0.5 --precision long-double --json");
   expect_same_result(
       "quantum --potential harmonic --dims 1 --grid 256 --box 20 --method M8 --dt 0.05 --steps 200 "
       "--json");
+}
+
+// An initial wave function from a file on a distributed grid: each rank takes its own slab of the file's values
+// (a packet displaced along the distributed axis, so that a rank reading another slab changes every result).
+TEST(QuantumMpi, TwoRanksReadTheirOwnSlabOfTheInitialFile) {
+  const auto dir = cli_test::temp_dir();
+  const auto file = dir / "psi0_2d.txt";
+  {
+    std::ofstream out(file);
+    out.precision(17);
+    for (int i = 0; i < 24; ++i)
+      for (int j = 0; j < 24; ++j) {
+        const double x = -6 + i * 0.5, y = -6 + j * 0.5;
+        const std::complex<double> z = std::exp(std::complex<double>(-((x - 1.5) * (x - 1.5) + y * y) / 2, 0.7 * x));
+        out << z.real() << " " << z.imag() << "\n";
+      }
+  }
+  expect_same_result("quantum --dims 2 --grid 24 --box 12 --method M6 --dt 0.05 --steps 20 --initial-file " +
+                     file.string() + " --json");
+  const auto r = nlohmann::json::parse(run("quantum --dims 2 --grid 24 --box 12 --method M6 --dt 0.05 --steps 20 "
+                                           "--initial-file " +
+                                           file.string() + " --json")
+                                           .out);
+  EXPECT_GT(r["mean_position"][0].get<double>(), 1.0);  // the packet where the file put it
 }
 
 // Ranks that were given different arguments or input files, or that cannot read their input, all stop before

@@ -193,6 +193,13 @@ QuantumResult solve(const QuantumProblem<R>& p, const std::string& method_name, 
     const auto first = p.values.begin() + static_cast<std::ptrdiff_t>(range.first);
     v.assign(first, first + static_cast<std::ptrdiff_t>(range.count));
   }
+  // |psi|^2 is not analytic in psi: sub-steps at complex times do not compose as a complex method's order
+  // conditions assume (BC1 and AC1 in imaginary time on g = 2 converge at first order, measured)
+  if (p.g != 0 && fm.info.complex)
+    throw invalid_input("'" + fm.info.name +
+                        "' has complex coefficients: on the Gross-Pitaevskii equation (g != 0) it loses its order "
+                        "(the nonlinearity |psi|^2 is not analytic in complex sub-steps); use a real method such as "
+                        "M4..M16 or PV");
   if (p.time == TimeKind::imaginary && !p.allow_negative_coefficients)
     if (const auto b = operators::backward_sub_step(fm))
       throw invalid_input(backward_method_message(fm.info.name, *b, vf && p.g == 0));
