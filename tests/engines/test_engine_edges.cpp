@@ -39,6 +39,12 @@ TEST(EngineEdges, MpeIsRefusedWhenItsAmplificationReachesTheSquareRootOfTheTypes
   const long below_ld = std::lround(std::exp2(31.25)), above_ld = std::lround(std::exp2(31.75));
   EXPECT_NO_THROW(mpe_coefficients_as<long double>(with_amplification(below_ld)));
   EXPECT_THROW(mpe_coefficients_as<long double>(with_amplification(above_ld)), std::invalid_argument);
+  // At the threshold itself half of the digits are lost, not more: accepted (double: amp = 2^26; float128, 113 bits:
+  // 2^56), and refused just above it.
+  EXPECT_NO_THROW(mpe_coefficients_as<double>(with_amplification(1L << 26)));
+  EXPECT_THROW(mpe_coefficients_as<double>(with_amplification((1L << 26) + 1)), std::invalid_argument);
+  EXPECT_NO_THROW(mpe_coefficients_as<float128>(with_amplification(1L << 56)));
+  EXPECT_THROW(mpe_coefficients_as<float128>(with_amplification((1L << 56) + (1L << 8))), std::invalid_argument);
   // The message names the order and the type.
   try {
     mpe_coefficients_as<double>(with_amplification(above_d));

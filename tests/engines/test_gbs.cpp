@@ -139,6 +139,76 @@ TEST(Gbs, ManyShortSpansAgreeWithOneLongSpan) {
   EXPECT_LT(std::abs(b.q[0] - ex.q[0]), 1e-11);
 }
 
+// The default first step (initial_step = 0) is the first call's span: no step size before the first call, and
+// that call bitwise the one of an engine told the span, force evaluations and rejections included.
+TEST(Gbs, TheDefaultFirstStepIsTheFirstCallsSpan) {
+  const KeplerProblem<double> prob{0.2};
+  for (const double span : {7.0, 0.3}) {
+    SCOPED_TRACE(span);
+    GbsOptions o;
+    o.rtol = o.atol = 1e-11;
+    GbsIntegrator<std::array<double, 2>, KeplerForce> by_default(KeplerForce{}, o);
+    EXPECT_EQ(by_default.step_size(), 0.0);
+    o.initial_step = span;
+    GbsIntegrator<std::array<double, 2>, KeplerForce> told(KeplerForce{}, o);
+    EXPECT_EQ(told.step_size(), span);
+    auto a = prob.initial_state(), b = a;
+    by_default.integrate_to(a, span);
+    told.integrate_to(b, span);
+    EXPECT_EQ(a.q, b.q);
+    EXPECT_EQ(a.v, b.v);
+    EXPECT_EQ(by_default.force_evals(), told.force_evals());
+    EXPECT_EQ(by_default.rejected(), told.rejected());
+    EXPECT_GT(by_default.steps(), 0);
+  }
+}
+
+// The columns after an accepted step, from the work per unit step W_j of j columns (HNW I, sec. II.9, ODEX): one
+// fewer when W_{k-1} < 0.8 W_k (from three columns), else one more when W_k < 0.9 W_{k-1} and the last attempt was
+// not rejected, within [2, kmax - 1]. Each threshold on both sides, with the other columns' work far off.
+TEST(Gbs, ColumnsFollowTheLeastWorkPerUnitStep) {
+  auto next = [](int kc, std::vector<double> W, bool rejected = false) {
+    return detail::gbs_next_columns(kc, W, 8, rejected);
+  };
+  //                      W_0 W_1  W_2   W_3   W_4  W_5
+  EXPECT_EQ(next(4, {0, 0, 10.0, 0.79, 1.0, 0.1}), 3);
+  EXPECT_EQ(next(4, {0, 0, 0.01, 0.81, 1.0, 0.1}), 4);
+  EXPECT_EQ(next(4, {0, 0, 10.0, 1.0, 0.89, 10.0}), 5);
+  EXPECT_EQ(next(4, {0, 0, 0.01, 1.0, 0.91, 0.01}), 4);
+  EXPECT_EQ(next(4, {0, 0, 10.0, 1.0, 0.89, 10.0}, true), 4);  // not up after a rejection
+  EXPECT_EQ(next(4, {0, 0, 10.0, 0.79, 1.0, 0.1}, true), 3);   // down also after one
+  EXPECT_EQ(next(2, {0, 1.0, 0.89, 10.0}), 3);                 // two columns: up only
+  EXPECT_EQ(next(2, {0, 0.01, 0.91, 0.01}), 2);
+  EXPECT_EQ(next(7, {0, 0, 1, 1, 1, 1, 10.0, 0.5, 0.1}), 7);  // at most kmax - 1
+  EXPECT_EQ(next(3, {0, 0, 0.5, 1.0, 0.1}), 2);               // down to two, the fewest
+}
+
+// A resume point must be one a run can have stopped at: 0 < t < span (both ends excluded), a finite step H > 0 and
+// 2 to kmax - 1 columns; anything else is refused with one line, and a good one is kept.
+TEST(Gbs, ResumePointsOutsideTheSpanAreRefused) {
+  GbsOptions o;
+  o.max_columns = 8;
+  GbsIntegrator<std::array<double, 2>, KeplerForce> g(KeplerForce{}, o);
+  using P = GbsIntegrator<std::array<double, 2>, KeplerForce>::ResumePoint;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const P& p :
+       {P{0.0, 1.0, 0.1, 4, false, true}, P{1.0, 1.0, 0.1, 4, false, true}, P{-0.5, 1.0, 0.1, 4, false, true},
+        P{0.5, 1.0, 0.0, 4, false, true}, P{0.5, 1.0, inf, 4, false, true}, P{0.5, 1.0, 0.1, 1, false, true},
+        P{0.5, 1.0, 0.1, 8, false, true}}) {
+    try {
+      g.set_resume_point(p);
+      ADD_FAILURE() << "t " << p.t << " span " << p.span << " H " << p.H << " k " << p.k << " accepted";
+    } catch (const invalid_input& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    }
+  }
+  g.set_resume_point(P{0.5, 1.0, 0.1, 7, false, true});
+  EXPECT_TRUE(g.resume_point().valid);
+  EXPECT_EQ(g.resume_point().t, 0.5);
+  g.set_resume_point(P{0.0, 0.0, 0.0, 0, false, false});  // an invalid point is no point: nothing to check
+  EXPECT_FALSE(g.resume_point().valid);
+}
+
 TEST(Gbs, FollowsTheTwoBodyProblemAsAnNBodySystem) {
   auto p = two_body(0.2);
   NBodyForce<double> f(p.m, 0.0);

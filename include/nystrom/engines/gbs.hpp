@@ -56,6 +56,19 @@ inline std::string fmt_g(double x) {
   std::snprintf(b, sizeof b, "%.3g", x);
   return b;
 }
+
+/// The columns of the next step after an accepted step of kc columns (HNW I, sec. II.9, as in ODEX), from the work
+/// per unit step W[j] of j columns: one fewer when W[kc - 1] < 0.8 W[kc] (from three columns); else one more
+/// when W[kc] < 0.9 W[kc - 1] and the step did not follow a rejection; kept within [2, km - 1].
+template <class R>
+int gbs_next_columns(int kc, const std::vector<R>& W, int km, bool last_rejected) {
+  int kn = kc;
+  if (kc >= 3 && W[static_cast<std::size_t>(kc) - 1] < R(0.8) * W[static_cast<std::size_t>(kc)]) kn = kc - 1;
+  if (kc >= 2 && kn == kc && !last_rejected && kc + 1 <= km - 1 &&
+      W[static_cast<std::size_t>(kc)] < R(0.9) * W[static_cast<std::size_t>(kc) - 1])
+    kn = kc + 1;
+  return std::clamp(kn, 2, km - 1);
+}
 }  // namespace detail
 
 inline GbsSequence parse_gbs_sequence(const std::string& s) {
@@ -428,13 +441,7 @@ class GbsIntegrator {
 
   void accept(int kc, real_type H, const std::vector<real_type>& Hj, const std::vector<real_type>& W,
               bool last_rejected, real_type& Hnew) {
-    const int km = opt_.max_columns;
-    int kn = kc;
-    if (kc >= 3 && W[static_cast<std::size_t>(kc) - 1] < real_type(0.8) * W[static_cast<std::size_t>(kc)]) kn = kc - 1;
-    if (kc >= 2 && kn == kc && !last_rejected && kc + 1 <= km - 1 &&
-        W[static_cast<std::size_t>(kc)] < real_type(0.9) * W[static_cast<std::size_t>(kc) - 1])
-      kn = kc + 1;
-    kn = std::clamp(kn, 2, km - 1);
+    const int kn = detail::gbs_next_columns(kc, W, opt_.max_columns, last_rejected);
     if (kn <= kc)
       Hnew = Hj[static_cast<std::size_t>(kn)];
     else

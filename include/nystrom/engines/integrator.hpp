@@ -28,8 +28,8 @@ template <class S>
 std::vector<S> mpe_coefficients_as(const MpeCoefficients& mc) {
   using T = real_t<S>;
   const double amp = mpe_amplification(mc);
-  // amp * eps < sqrt(eps), in logarithms (eps = 2^(1-bits) underflows a double beyond 1074 bits).
-  if (!(std::log2(amp) < 0.5 * static_cast<double>(scalar_traits<T>::bits() - 1)))
+  // amp * eps <= sqrt(eps), in logarithms (eps = 2^(1-bits) underflows a double beyond 1074 bits).
+  if (!(std::log2(amp) <= 0.5 * static_cast<double>(scalar_traits<T>::bits() - 1)))
     throw std::invalid_argument("MPE order " + std::to_string(mc.order()) + " is beyond what " +
                                 scalar_traits<T>::name() + " can represent: the coefficients amplify rounding by " +
                                 std::to_string(amp) + " (use a wider --precision)");
