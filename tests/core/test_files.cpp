@@ -141,6 +141,18 @@ TEST(FileWriter, RefusesFoldersDevicesFifosAndSymlinks) {
   fs::remove_all(dir);
 }
 
+// A path whose last component is no file name (empty after a slash, ".", "..") is refused as such, whether or not
+// the folder before it exists, and nothing is created.
+TEST(FileWriter, APathEndingInNoFileNameIsRefused) {
+  const auto dir = fresh_dir();
+  for (const std::string tail : {"missing/", "missing/.", "missing/..", "x/./"}) {
+    const std::string path = (dir / tail).string();
+    const std::string msg = error_of([&] { write_file_atomic(path, "x\n"); });
+    EXPECT_NE(msg.find("'" + path + "': not a file name"), std::string::npos) << msg;
+  }
+  EXPECT_TRUE(listing(dir).empty());
+}
+
 TEST(FileWriter, NeverWritesThroughOrConsumesAPlantedTemporaryName) {
   const auto dir = fresh_dir();
   const auto path = dir / "run.checkpoint";
@@ -399,6 +411,13 @@ TEST(Checkpoint, ValuesNoRunCanHaveWrittenAreRefusedWithAValidChecksum) {
       {with_line(adaptive, "q_prev", "q_prev -0x1p+0"), "history is negative"},
       {with_checksum(body_of(gbs) + "extra 1\n"), "unexpected lines"},
       {gbs + "trailing\n", "no checksum line"},
+      // a number cut short at every place of its grammar
+      {with_line(gbs, "t", "t 0x1.8p"), "not a number in hexadecimal"},
+      {with_line(gbs, "t", "t 0x1.8p+"), "not a number in hexadecimal"},
+      {with_line(gbs, "t", "t 0x1.8"), "not a number in hexadecimal"},
+      {with_line(gbs, "t", "t 0x1."), "not a number in hexadecimal"},
+      {with_line(gbs, "t", "t 0x"), "not a number in hexadecimal"},
+      {with_line(gbs, "t", "t -"), "not a number in hexadecimal"},
   };
   for (const auto& c : cases) {
     if (c.why.empty()) continue;

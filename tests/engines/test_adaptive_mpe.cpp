@@ -460,3 +460,22 @@ TEST(AdaptiveMpeOrderControl, MalformedTablesAreRefusedFromTwoProducts) {
     EXPECT_THROW(make(inf), std::invalid_argument) << n;
   }
 }
+
+// One coefficient and one error weight per member of the sequence: either one too short, or both, is refused.
+TEST(AdaptiveMpe, CoefficientsOfTheWrongLengthAreRefused) {
+  const std::vector<long> k = {1, 2, 3};
+  const AdaptiveMpeCoefficients ac = adaptive_mpe_coefficients(k);
+  auto conv = [](const bigcomplex& x) { return to_scalar<double>(x); };
+  const auto base = convert_scheme<double>(velocity_verlet_scheme(), conv);
+  const std::vector<double> c = mpe_coefficients_as<double>(ac.high), d = mpe_coefficients_as<double>(ac.error());
+  long calls = 0;
+  auto make = [&](std::vector<double> cc, std::vector<double> dd) {
+    return AdaptiveMpeIntegrator<V2, CountingKepler>(k, std::move(cc), std::move(dd), base, CountingKepler{&calls},
+                                                     with_tol(1e-8));
+  };
+  EXPECT_EQ(make(c, d).sequence(), k);
+  const std::vector<double> c_short(c.begin(), c.end() - 1), d_short(d.begin(), d.end() - 1);
+  EXPECT_THROW(make(c_short, d), std::invalid_argument);
+  EXPECT_THROW(make(c, d_short), std::invalid_argument);
+  EXPECT_THROW(make(c_short, d_short), std::invalid_argument);
+}

@@ -77,3 +77,27 @@ TEST(CatalogSpecs, AdjointReversesTheSubSteps) {
     EXPECT_EQ(resolve_method("adjoint:adjoint:" + base).info.name, b.info.name);
   }
 }
+
+// GBS:SEQUENCE:COLUMNS: the sequence and the number of columns its name gives (order twice the columns, from 3 to
+// 20 columns); a columns field that is empty, not a number, too long or out of range is refused with one line.
+TEST(CatalogSpecs, GbsWithItsSequenceAndColumns) {
+  const MethodDef d8 = resolve_solve_method("GBS:harmonic:8");
+  EXPECT_EQ(d8.info.order, 16);
+  EXPECT_EQ(std::get<GbsDef>(d8.build()).max_columns, 8);
+  EXPECT_EQ(std::get<GbsDef>(d8.build()).sequence, GbsSequence::harmonic);
+  const MethodDef b20 = resolve_solve_method("gbs:Bulirsch:20");
+  EXPECT_EQ(b20.info.order, 40);
+  EXPECT_EQ(std::get<GbsDef>(b20.build()).sequence, GbsSequence::bulirsch);
+  EXPECT_EQ(resolve_solve_method("GBS:romberg:3").info.order, 6);
+  EXPECT_EQ(resolve_solve_method("GBS:romberg").info.order, resolve_solve_method("GBS").info.order);
+  for (const std::string spec : {"GBS:harmonic:", "GBS:harmonic:x", "GBS:harmonic:1e1", "GBS:harmonic:-8",
+                                 "GBS:harmonic:123", "GBS:harmonic:2", "GBS:harmonic:21", "GBS:fibonacci:8"}) {
+    try {
+      (void)resolve_solve_method(spec);
+      ADD_FAILURE() << spec << " was accepted";
+    } catch (const invalid_input& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      EXPECT_NE(std::string(e.what()).find("GBS:SEQUENCE:COLUMNS"), std::string::npos) << e.what();
+    }
+  }
+}

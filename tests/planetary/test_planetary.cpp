@@ -776,3 +776,31 @@ TEST(PlanetarySystem, AngularMomentumOfTwoBodiesByHand) {
   EXPECT_EQ(one[1], 12);
   EXPECT_EQ(one[2], -6);
 }
+
+// The short-drift path takes every orbit whose series terms are small, |u a2| + |u^2 a3| <= 1/4 with u = dt / r0
+// (and |beta s^2| <= 2.5), however large a3 itself: at the pericentre of e = 0.9 (r0 = 0.1, a3 = -1.5) a drift of
+// 1e-3 (u = 0.01, u^2 a3 = -1.5e-4) is solved there in either direction, as the bracketed iteration solves it;
+// a drift of 0.2 (u = 2, u^2 a3 = -6) is declined and leaves the orbit as it was.
+TEST(KeplerDrift, ShortDriftPathTakesEveryOrbitWhoseSeriesTermsAreSmall) {
+  const double r0 = 0.1, mu = 1.0, vp = std::sqrt(mu * 1.9 / r0);  // e = 0.9 at its pericentre
+  for (const Vec3<double>& vel : {Vec3<double>{0, vp, 0}, Vec3<double>{0.3, vp, 0.2}}) {
+    for (const double dt : {1e-3, -1e-3, 2e-3}) {
+      SCOPED_TRACE(dt);
+      Vec3<double> x{r0, 0, 0}, v = vel, xb = x, vb = v;
+      detail::kepler_drift_bracketed(mu, dt, xb, vb);
+      bool done = false;
+      detail::kepler_drift_short<double>(
+          1, dt, [&](std::size_t) { return mu; }, x.data(), v.data(), &done);
+      ASSERT_TRUE(done);
+      EXPECT_LT(distance(x, xb), 16 * kEps * (r0 + std::fabs(dt) * norm3(vel)));
+      EXPECT_LT(distance(v, vb), 16 * kEps * norm3(vel));
+    }
+    Vec3<double> x{r0, 0, 0}, v = vel;
+    bool done = true;
+    detail::kepler_drift_short<double>(
+        1, 0.2, [&](std::size_t) { return mu; }, x.data(), v.data(), &done);
+    EXPECT_FALSE(done);
+    EXPECT_EQ(x, (Vec3<double>{r0, 0, 0}));
+    EXPECT_EQ(v, vel);
+  }
+}

@@ -402,6 +402,22 @@ TEST(Thermal, JacobiEigenvaluesAtEveryScale) {
   }
 }
 
+// The number of beads may be anything from 1 to 1000000 (both ends included); 0 and 1000001 are refused.
+TEST(Thermal, BeadsFromOneToAMillion) {
+  ThermalProblem<double> p;
+  p.grid = 4;
+  p.box = 4;
+  p.beta = 1;
+  p.beads = {1, 1000000};
+  const auto r = thermal(p);
+  ASSERT_EQ(r.rows.size(), 2u);
+  EXPECT_GT(r.rows[1].z_primitive, 0);
+  for (const long b : {0L, 1000001L, -5L}) {
+    p.beads = {b};
+    EXPECT_THROW(thermal(p), std::invalid_argument) << b;
+  }
+}
+
 TEST(Thermal, BadInputIsRefused) {
   auto refused = [](auto change) {
     ThermalProblem<double> p;
