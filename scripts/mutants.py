@@ -5,6 +5,7 @@
     python3 scripts/mutants.py --seed 1 --count 60 --list     # the sample only (no build)
     python3 scripts/mutants.py --seed 1 --count 60 --only 3,17 # some mutants of that sample
     python3 scripts/mutants.py --seed 7 --count 3 --layers core,operators --max-seconds 170   # CI's sample
+    python3 scripts/mutants.py --replay build/mutants/report-1.json   # that sample again, on today's code
 
 Every mutation site of the library's code is enumerated in a fixed order, then `--count` of them are
 drawn with random.Random(seed). The code is include/nystrom/{engines,solve,operators,quantum,planetary,core}/
@@ -34,6 +35,11 @@ report goes to build/mutants/report-<seed>.json and ends with the line
 where M counts the mutants that compiled and E those of the survivors that EQUIVALENT lists (a mutant is
 named by file, line and its text, so the list survives unrelated edits elsewhere in the file). The exit
 status is 1 when a survivor is not listed as equivalent.
+
+A sample is drawn from the sites of the code of its day: once the code changes, the same seed draws other
+mutants. --replay runs the mutants of a report again (each found by the text of its line, the nearest one to
+its recorded line when several match; a mutant whose line is gone is counted apart), so that a sample's
+score can be re-measured after every change. Its report goes to build/mutants/replay-<seed>.json.
 """
 
 import argparse
@@ -66,6 +72,7 @@ FILE_LAYER = [
     ("include/nystrom/engines/adaptive_mpe", "adaptive_mpe"),
     ("include/nystrom/engines/gbs.hpp", "gbs"),
     ("include/nystrom/engines/mpe_midpoint.hpp", "velocity"),
+    ("include/nystrom/engines/options.hpp", "options"),
     ("include/nystrom/engines/", "engines"),
     ("include/nystrom/solve/odeint.hpp", "odeint"),
     ("include/nystrom/solve/checkpoint.hpp", "checkpoint"),
@@ -93,6 +100,7 @@ LAYERS = {
     "operators": ["test_operators"],
     "quantum": ["test_quantum", "test_diffusion"],
     "velocity": ["test_velocity", "test_solve_directions"],
+    "options": ["test_gbs", "test_adaptive_rkn", "test_adaptive_mpe", "test_engine_edges"],
     "planetary": ["test_planetary", "test_engine_edges"],
     "files": ["test_files"],
     "core": ["test_precision", "test_compensated", "test_carry", "test_engine_edges"],
@@ -110,6 +118,26 @@ EQUIVALENT = {
      "inline constexpr std::size_t kKeplerBatch = 9;"):
     "the batch size of the short-drift path only groups orbits, each computed from its own data alone, in a loop "
     "that takes any batch size: the same results",
+    ("include/nystrom/solve/drivers.hpp", "return dir > 0 ? t : T(-t);", "return dir >= 0 ? t : T(-t);"):
+    "the direction is +1 or -1, never 0 (solve_run sets it from the sign of t1 - t0, 1 when they are equal; the "
+    "converters start at 1): the two tests agree on every value it takes",
+    ("include/nystrom/solve/drivers.hpp",
+     "const R hk = (opt.steps <= 0 && k == n - 1) ? R((tau1 - tau0) - h * R(n - 1)) : h;",
+     "const R hk = (opt.steps <= 1 && k == n - 1) ? R((tau1 - tau0) - h * R(n - 1)) : h;"):
+    "it differs only for steps = 1, where the one step's length is h = |t1 - t0| / 1 and the mutant's is "
+    "(tau1 - tau0) - 0 h with tau = +-t: the same number, since negation is exact and rounding is symmetric",
+    ("include/nystrom/engines/gbs.hpp", "out.q[c] = std::min(t, clock_end_);", "out.q[c] = std::min(clock_end_, t);"):
+    "std::min of two numbers is the same number in either order; the two differ only for equal zeros of opposite "
+    "sign (a clock that reaches t1 = 0 gives the force t = +0 or -0, the same time) or a NaN clock (a failed step, "
+    "refused either way)",
+    ("include/nystrom/planetary/kepler_drift.hpp", "if (f < 0 || (!std::isfinite(static_cast<double>(f)) && s < 0))",
+     "if (f <= 0 || (!std::isfinite(static_cast<double>(f)) && s < 0))"):
+    "they differ only for f = 0 exactly, which never reaches the line: the convergence test just before it "
+    "accepts |f| <= 4 eps (...) when f and r are finite, and an f of 0 with an r that is not finite cannot occur "
+    "(r's G-functions g1, g2 enter f with g3, and overflow together)",
+    ("include/nystrom/core/files.hpp", "out.resize(std::min(max_bytes + 1, out.size() * 2 + 4096));",
+     "out.resize(std::min(out.size() * 2 + 4096, max_bytes + 1));"):
+    "std::min of two values is the same value in either order",
     ("include/nystrom/quantum/schrodinger.hpp", "if (g_ != 0 && step_ > 0) {", "if (g_ != 0 || step_ > 0) {"):
     "for g = 0 the chemical-potential shift is never read (apply_b's linear branch does not use it, and "
     "chemical_potential_shift() has no caller), so accumulating it there changes no result",
@@ -352,6 +380,24 @@ def describe(root, site):
             "layer": layer_of(rel)}
 
 
+def relocate(root, m):
+    """The site of a recorded mutant (a report's file, line, before and after) in today's sources: the line
+    whose text is `before` (the one nearest the recorded line when several are), replaced whole by `after`
+    with its indentation kept. None when no such line is left (the code changed)."""
+    with open(os.path.join(root, m["file"])) as f:
+        text = f.read()
+    starts, pos = [], 0
+    for line in text.split("\n"):
+        if line.strip() == m["before"]:
+            starts.append((pos, line))
+        pos += len(line) + 1
+    if not starts:
+        return None
+    best = min(starts, key=lambda sl: abs(text.count("\n", 0, sl[0]) + 1 - m["line"]))
+    off = best[0] + len(best[1]) - len(best[1].lstrip())
+    return (m["file"], off, len(best[1].strip()), m["after"], m["kind"])
+
+
 def sample(root, seed, count, layers=None):
     allsites = enumerate_sites(root)
     if layers:
@@ -381,11 +427,14 @@ def summarize(results, build, args, allsites, final, name="report"):
     survived = [r for r in results if r["verdict"] == "survived"]
     invalid = sum(r["verdict"] == "does not compile" for r in results)
     notrun = sum(r["verdict"] == "not run" for r in results)
+    gone = sum(r["verdict"] == "gone" for r in results)
     compiled = killed + equivalent + len(survived)
     report = {"seed": args.seed, "count": args.count, "sites": len(allsites), "killed": killed,
               "compiled": compiled, "equivalent": equivalent, "does_not_compile": invalid, "not_run": notrun,
-              "mutants": results}
+              "gone": gone, "mutants": results}
     os.makedirs(build, exist_ok=True)
+    if getattr(args, "replay", None) and name == "report":
+        name = "replay"
     out = os.path.join(build, f"{name}-{args.seed}.json")
     with open(out + ".tmp", "w") as f:
         json.dump(report, f, indent=1)
@@ -395,7 +444,8 @@ def summarize(results, build, args, allsites, final, name="report"):
         return survived, line
     for r in survived:
         print(f"survivor {r['number']}: {r['file']}:{r['line']} '{r['before']}' -> '{r['after']}'")
-    print(f"{invalid} did not compile" + (f", {notrun} not run (time budget)" if notrun else "") + f"; report: {out}")
+    print(f"{invalid} did not compile" + (f", {notrun} not run (time budget)" if notrun else "") +
+          (f", {gone} gone (their line changed since the sample was drawn)" if gone else "") + f"; report: {out}")
     print(line)
     return survived, line
 
@@ -417,6 +467,10 @@ def main():
                     help="the lib/solve_<type>.cpp the scratch library compiles (comma-separated, or none)")
     ap.add_argument("--without", default="", help="comma-separated test programs to leave out of every layer")
     ap.add_argument("--keep-src", action="store_true", help="reuse the copy of the sources as it is")
+    ap.add_argument("--replay", metavar="JSON",
+                    help="run the mutants of this report again on today's sources and tests (the same sample after "
+                         "the code changed: each found by its line's text; one whose line is gone is reported so); "
+                         "--only selects by the report's numbers")
     ap.add_argument("--report", nargs="+", metavar="JSON",
                     help="merge these reports of one seed (e.g. two runs of disjoint --only sets) and summarise them "
                          "with today's EQUIVALENT table; builds nothing")
@@ -453,8 +507,21 @@ def main():
     layers = set(args.layers.split(",")) if args.layers else None
     if layers and not layers <= set(LAYERS):
         raise SystemExit(f"mutants: unknown layer in {args.layers} (layers: {', '.join(sorted(LAYERS))})")
-    allsites, picked = sample(ROOT, args.seed, args.count, layers)
-    muts = [describe(ROOT, s) for s in picked]
+    if args.replay:
+        with open(args.replay) as f:
+            rep = json.load(f)
+        args.seed, args.count = rep["seed"], rep["count"]
+        allsites = range(rep["sites"])
+        recorded = {r["number"]: r for r in rep["mutants"] if r["verdict"] not in ("does not compile", "not run")}
+        picked = [None] * max(recorded, default=0)
+        muts = [None] * len(picked)
+        for n, r in recorded.items():
+            picked[n - 1] = relocate(ROOT, r)
+            muts[n - 1] = describe(ROOT, picked[n - 1]) if picked[n - 1] else {
+                k: r[k] for k in ("file", "line", "kind", "before", "after", "layer")}
+    else:
+        allsites, picked = sample(ROOT, args.seed, args.count, layers)
+        muts = [describe(ROOT, s) for s in picked]
     if args.list:
         print(f"{len(allsites)} mutation sites; seed {args.seed}, {len(picked)} drawn")
         for i, d in enumerate(muts, 1):
@@ -462,6 +529,7 @@ def main():
                   f"      + {d['after']}")
         return 0
     only = [int(x) for x in args.only.split(",")] if args.only else range(1, len(picked) + 1)
+    only = [i for i in only if 1 <= i <= len(muts) and muts[i - 1] is not None]
     if args.run_layers:
         only = [i for i in only if muts[i - 1]["layer"] in args.run_layers.split(",")]
     t_start = time.time()
@@ -544,6 +612,11 @@ def main():
     results = []
     for i in only:
         d = dict(muts[i - 1], number=i)
+        if picked[i - 1] is None:
+            d["verdict"] = "gone"
+            results.append(d)
+            print(f"mutant {i}: gone (no line '{d['before']}' in {d['file']} today)", flush=True)
+            continue
         rel, off, length, new, kind = picked[i - 1]
         if args.max_seconds and time.time() - t_start > args.max_seconds:
             d["verdict"] = "not run"
