@@ -135,6 +135,8 @@ def test_long_double_agrees_with_double():
     (dict(potential_values=np.zeros(10)), r"potential_values has shape \(10,\), expected \(256,\)"),
     (dict(potential_values=np.full(256, np.nan)), "the potential is not finite"),
     (dict(potential_values=np.zeros(256), method="4A"), "needs the potential as a function"),
+    (dict(method="BC1", g=2.0), "on the Gross-Pitaevskii equation"),
+    (dict(method="AC1", g=1.0, imaginary_time=True), "on the Gross-Pitaevskii equation"),
 ])
 def test_bad_input_raises_value_error_with_the_library_message(kwargs, match):
     with pytest.raises(ValueError, match=match):

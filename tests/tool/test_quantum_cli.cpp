@@ -250,7 +250,9 @@ TEST(QuantumCli, BadInputExitsTwoWithOneLine) {
                                  "--states 0",
                                  "--states 2",
                                  "--states 2 --imaginary-time --g 1",
-                                 "--method 4A --g 1"}) {
+                                 "--method 4A --g 1",
+                                 "--method BC1 --g 2",
+                                 "--method AC1 --g 1 --imaginary-time"}) {
     const auto r = run("quantum " + args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.err;
     EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;
