@@ -36,6 +36,18 @@ SmoluchowskiProblem<double> ou_problem() {
   return p;
 }
 
+/// The double well (the default potential) on 64 points over a box of 6, from a Gaussian of width 0.2 in the left
+/// well, the final density kept.
+SmoluchowskiProblem<double> left_well_start() {
+  SmoluchowskiProblem<double> p;
+  p.grid = 64;
+  p.box = 6;
+  p.x0 = {-1.0};
+  p.width = 0.2;
+  p.keep_density = true;
+  return p;
+}
+
 /// The slope log2(e(n) / e(2n)) of the last pair above the rounding floor, and the errors for the message.
 double observed_order(const std::vector<double>& e, double floor, std::string& log) {
   double order = std::nan("");
@@ -151,12 +163,7 @@ TEST(Smoluchowski, BackwardMethodsAreRefusedWithOneLine) {
 // From a Gaussian in the left well the density relaxes to the normalised Boltzmann density e^{-beta U} / Z of the
 // double well, computed here from U; the mass stays 1.
 TEST(Smoluchowski, DoubleWellRelaxesToTheBoltzmannDensity) {
-  SmoluchowskiProblem<double> p;
-  p.grid = 64;
-  p.box = 6;
-  p.x0 = {-1.0};
-  p.width = 0.2;
-  p.keep_density = true;
+  const SmoluchowskiProblem<double> p = left_well_start();
   // t = 40: e^{-lambda_1 t} ~ 1e-11. The mass drifts linearly in time with the method's ground-state shift, O(h^8)
   // with error constants as large as |grad W|^2 where the density lives (measured at t = 40: 5e-4 at h = 0.05,
   // 6e-6 at h = 0.025, 3e-8 at h = 0.01)
@@ -283,12 +290,7 @@ TEST(Smoluchowski, PotentialValuesGiveTheBuiltInResult) {
 // the mass drifts measurably (so that dividing by the mass and multiplying by it differ), computed here from the
 // density itself.
 TEST(Smoluchowski, MomentsAreThoseOfTheKeptDensityPerUnitMass) {
-  SmoluchowskiProblem<double> p;
-  p.grid = 64;
-  p.box = 6;
-  p.x0 = {-1.0};
-  p.width = 0.2;
-  p.keep_density = true;
+  const SmoluchowskiProblem<double> p = left_well_start();
   const auto r = smoluchowski(p, "M8", 0.05, 200);
   ASSERT_EQ(r.density.size(), 64u);
   const Grid<double> g(1, 64, 6.0);
