@@ -298,22 +298,25 @@ TEST(AdaptiveController, TheStepCarriedPastTheEndIsTheNewProposalUnlessTheLastSt
   AdaptiveResumePoint<double> none;
   double h, carried = 0;
   bool last;
+  auto sequence = [&] {  // over [0, 1], first step 0.5
+    return adaptive_detail::StepSequence<double>(opt, none, carried, 0.0, 1.0, [](const double&) { return 0.0; });
+  };
   // From 0.5 the proposal 0.5 lands on 1 exactly: accepted with q = 1/2, the next proposal is 0.9 * 0.5 * 0.5.
-  adaptive_detail::StepSequence<double> full(opt, none, carried, 0.0, 1.0, [](const double&) { return 0.0; });
+  auto full = sequence();
   ASSERT_TRUE(full.next<true>(0.5, h, last));
   EXPECT_TRUE(last);
   EXPECT_EQ(h, 0.5);
   full.accepted(0.5, h, last, carried);
   EXPECT_DOUBLE_EQ(carried, 0.225);
   // From 0.6 the step is shortened to 0.4: accepted with q = 2 (a proposal of 0.72), it carries the earlier 0.5.
-  adaptive_detail::StepSequence<double> cut(opt, none, carried, 0.0, 1.0, [](const double&) { return 0.0; });
+  auto cut = sequence();
   ASSERT_TRUE(cut.next<true>(0.6, h, last));
   EXPECT_TRUE(last);
   EXPECT_DOUBLE_EQ(h, 0.4);
   cut.accepted(2.0, h, last, carried);
   EXPECT_EQ(carried, 0.5);
   // Not the last step: the new proposal, whatever its length.
-  adaptive_detail::StepSequence<double> mid(opt, none, carried, 0.0, 1.0, [](const double&) { return 0.0; });
+  auto mid = sequence();
   ASSERT_TRUE(mid.next<true>(0.0, h, last));
   EXPECT_FALSE(last);
   mid.accepted(0.5, h, last, carried);
