@@ -15,7 +15,9 @@
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/chin2010.hpp"
 #include "nystrom/methods/compositions.hpp"
+#include "nystrom/methods/dop853.hpp"
 #include "nystrom/methods/dormand_prince1987.hpp"
+#include "nystrom/methods/fine1987.hpp"
 #include "nystrom/methods/gurkan.hpp"
 #include "nystrom/methods/method.hpp"
 
@@ -50,6 +52,7 @@ void finalize_info(MethodDef& d) {
     in.fsal = t->fsal();
     in.complex = any_complex(t->c) || any_complex(t->b) || any_complex(t->B);
     in.adaptive = in.adaptive || !t->bhat.empty();
+    in.velocity = in.velocity || t->general();
   } else if (const auto* m = std::get_if<MpeDef>(&data)) {
     long sum = 0;
     for (long k : m->k) sum += k;
@@ -81,6 +84,8 @@ const std::vector<MethodDef>& catalog() {
     add(methods::blanes_moan2002());
     add(methods::gurkan());
     add(methods::dormand_prince1987());
+    add(methods::dop853_methods());
+    add(methods::fine1987_methods());
     for (auto& d : v) detail::finalize_info(d);
     return v;
   }();

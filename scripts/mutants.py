@@ -73,6 +73,7 @@ FILE_LAYER = [
     ("include/nystrom/engines/gbs.hpp", "gbs"),
     ("include/nystrom/engines/mpe_midpoint.hpp", "velocity"),
     ("include/nystrom/engines/options.hpp", "options"),
+    ("include/nystrom/engines/rkn.hpp", "rkn"),
     ("include/nystrom/engines/", "engines"),
     ("include/nystrom/solve/odeint.hpp", "odeint"),
     ("include/nystrom/solve/checkpoint.hpp", "checkpoint"),
@@ -88,12 +89,13 @@ FILE_LAYER = [
 ]
 LAYERS = {
     "engines": ["test_engines", "test_compensated", "test_carry", "test_engine_edges"],
+    "rkn": ["test_engines", "test_compensated", "test_carry", "test_engine_edges", "test_adaptive_rkn"],
     "step_control": ["test_adaptive_rkn", "test_adaptive_mpe", "test_adaptive_cost", "test_carry",
                      "test_solve_directions"],
     "adaptive_rkn": ["test_adaptive_rkn", "test_adaptive_cost", "test_carry", "test_solve_directions"],
     "adaptive_mpe": ["test_adaptive_mpe", "test_adaptive_cost", "test_carry", "test_solve_directions"],
     "gbs": ["test_gbs", "test_adaptive_cost", "test_engine_edges", "test_solve_directions"],
-    "solve": ["test_solve", "test_dense", "test_solve_directions"],
+    "solve": ["test_solve", "test_dense", "test_solve_directions", "test_velocity"],
     "checkpoint": ["test_solve", "test_solve_directions", "test_files"],
     "odeint": ["test_solve_odeint"],
     "catalog": ["test_engines", "test_properties", "test_catalog_specs"],

@@ -107,11 +107,27 @@ int method(const Options& o) {
     nlohmann::json a = nlohmann::json::array();
     for (const auto& row : t->a) a.push_back(vec(row));
     j["a"] = a;
-    text << def.info.name << ": RKN tableau (Gurkan eq 2.1)\n";
+    if (!t->bhat.empty()) {  // the embedded weights of a pair
+      j["bhat"] = vec(t->bhat);
+      j["Bhat"] = vec(t->Bhat);
+    }
+    if (t->general()) {  // the velocity coefficients of a general (RKNG) tableau
+      nlohmann::json av = nlohmann::json::array();
+      for (const auto& row : t->av) av.push_back(vec(row));
+      j["av"] = av;
+    }
+    text << def.info.name
+         << (t->general() ? ": general RKN tableau for y'' = f(t, y, y') (stage velocities v + h sum av f)\n"
+                          : ": RKN tableau (Gurkan eq 2.1)\n");
     for (std::size_t i = 0; i < t->c.size(); ++i) {
-      text << "  stage " << i + 1 << ": c = " << str(t->c[i]) << ", b = " << str(t->b[i]) << ", B = " << str(t->B[i])
-           << "\n      a =";
+      text << "  stage " << i + 1 << ": c = " << str(t->c[i]) << ", b = " << str(t->b[i]) << ", B = " << str(t->B[i]);
+      if (!t->bhat.empty()) text << ", bhat = " << str(t->bhat[i]) << ", Bhat = " << str(t->Bhat[i]);
+      text << "\n      a =";
       for (std::size_t jx = 0; jx < i; ++jx) text << " " << str(t->a[i][jx]);
+      if (t->general()) {
+        text << "\n      av =";
+        for (std::size_t jx = 0; jx < i; ++jx) text << " " << str(t->av[i][jx]);
+      }
       text << "\n";
     }
   } else {

@@ -111,13 +111,18 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
       "A force a(t, q, v) (`force(q, v, a)` or `force(t, q, v, a)` in C++, `force(t, q, v)` in Python; `nystrom run\n"
       "--problem arenstorf` or `damped-oscillator`) runs only with the methods for y'' = f(t, y, y'): " +
       join(nystrom::velocity_methods(), ", ") +
-      ";\n`GBS` runs the first-order form z = (q, v) with Gragg's modified midpoint rule as its base, adaptive in "
-      "order\n"
-      "and step. `mpe-midpoint:K1,K2,...` is the multi-product expansion (Chin 2010, eq 14) over the same rule with\n"
-      "2k substeps, whose error expands in even powers of the step as a symmetric base's does: order 2n for n\n"
-      "products, fixed steps, 1 + sum(2k_i - 1) force evaluations per step. First-order systems y' = f(t, y) run\n"
-      "with the same methods. Every other method of the catalog is made for a(t, q) and is refused with one line\n"
-      "naming these.\n";
+      ";\n`DOP853-adaptive` (alias `DOP853`; Dormand and Prince's pair of order 8 written as a general\n"
+      "Runge-Kutta-Nystrom method: the Runge-Kutta method itself on the first-order system) and Fine's\n"
+      "`Fine5-adaptive` and `Fine4-adaptive` are general RKN (RKNG) pairs: their stages carry velocity\n"
+      "coefficients (listed with the table's a, b, B by `nystrom coeffs`), they run with a tolerance, with\n"
+      "step-size control from their embedded weights (DOP853: Hairer's estimate from its weights of orders 5\n"
+      "and 3; Fine's: orders 4 and 3), and their dense output continues from the last step end with the main\n"
+      "weights. `GBS` runs the first-order form z = (q, v) with Gragg's modified midpoint rule as its base,\n"
+      "adaptive in order and step. `mpe-midpoint:K1,K2,...` is the multi-product expansion (Chin 2010, eq 14)\n"
+      "over the same rule with 2k substeps, whose error expands in even powers of the step as a symmetric base's\n"
+      "does: order 2n for n products, fixed steps, 1 + sum(2k_i - 1) force evaluations per step. First-order\n"
+      "systems y' = f(t, y) run with the same methods. Every other method of the catalog is made for a(t, q) and\n"
+      "is refused with one line naming these.\n";
   page +=
       "\n## Planetary maps\n\n"
       "`nystrom run --problem outer-solar-system` also runs the Wisdom-Holman maps (docs/planetary.md): a stage is\n"

@@ -11,6 +11,7 @@
 
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/methods/dop853.hpp"
 #include "nystrom/methods/rkn_order_conditions.hpp"
 #include "nystrom/problems/counting_force.hpp"
 #include "nystrom/problems/kepler.hpp"
@@ -260,4 +261,266 @@ TEST(AdaptiveRkn, TableauOrderIsCappedAtFourteenUnlessAskedForMore) {
   EXPECT_EQ(tableau_order(t), 14);
   EXPECT_EQ(tableau_order(t, 15), 15);
   EXPECT_EQ(tableau_order(t, 10), 10);
+}
+
+// ---- general (RKNG) pairs for y'' = f(t, y, y'): Fine's 4(3) and 5(4), DOP853 in Nystrom form ----------
+
+namespace {
+
+// A nonlinear force that depends on the velocity (a pendulum with quadratic drag, coupled): no part of it
+// is linear, so every elementary differential of y'' = f(y, y') is present.
+struct DraggedPendulum {
+  template <class V>
+  void operator()(const V& q, const V& v, V& a) const {
+    using std::cos;
+    using std::sin;
+    a[0] = -sin(q[0]) - 0.3L * v[0] * v[1] + 0.1L * cos(q[1]);
+    a[1] = -q[1] * (1 + q[0] * q[0]) - 0.2L * v[1] * v[1] * v[1] + 0.25L * v[0];
+  }
+};
+
+const State<V2> kPendulumStart{{0.5L, -0.3L}, {0.2L, 0.7L}};
+
+// The catalog's general pairs, as long double tableaux.
+std::vector<std::pair<std::string, RknTableau<LD>>> general_pairs() {
+  std::vector<std::pair<std::string, RknTableau<LD>>> out;
+  for (const auto& d : catalog()) {
+    BigPrecision guard(128);
+    const MethodData data = d.build();
+    const auto* t = std::get_if<RknTableau<bigcomplex>>(&data);
+    if (!t || !t->general()) continue;
+    out.emplace_back(d.info.name, convert_tableau<LD>(*t, [](const bigcomplex& x) { return to_scalar<LD>(x); }));
+  }
+  return out;
+}
+
+// n fixed steps of h (either sign) with the main weights of t, or with its embedded weights.
+State<V2> rkng_run(RknTableau<LD> t, bool embedded, LD h, long n) {
+  if (embedded) {
+    t.b = t.bhat;
+    t.B = t.Bhat;
+  }
+  t.bhat.clear();
+  t.Bhat.clear();
+  t.blow.clear();
+  t.Blow.clear();
+  RknStepper<V2, DraggedPendulum> st(t, DraggedPendulum{});
+  State<V2> s = kPendulumStart;
+  st.integrate(s, h, n);
+  return s;
+}
+
+// The first-order Runge-Kutta form of DOP853 on z = (q, v), z' = (v, f(q, v)), written out from the published
+// coefficients: the reference that the Nystrom form must reproduce.
+State<V2> dop853_first_order_step(const State<V2>& s, LD h) {
+  const auto& A = methods::dop853::a();
+  const std::size_t st = A.size();
+  std::vector<V2> kq(st), kv(st);
+  auto coef = [](const std::string& x) { return std::stold(x); };
+  for (std::size_t i = 0; i + 1 < st; ++i) {  // stages 1-12; the 13th row holds the weights
+    State<V2> z = s;
+    for (std::size_t j = 0; j < A[i].size(); ++j)
+      for (int c = 0; c < 2; ++c) {
+        z.q[c] += h * coef(A[i][j]) * kq[j][c];
+        z.v[c] += h * coef(A[i][j]) * kv[j][c];
+      }
+    kq[i] = z.v;
+    DraggedPendulum{}(z.q, z.v, kv[i]);
+  }
+  State<V2> out = s;
+  for (std::size_t j = 0; j < A[st - 1].size(); ++j)
+    for (int c = 0; c < 2; ++c) {
+      out.q[c] += h * coef(A[st - 1][j]) * kq[j][c];
+      out.v[c] += h * coef(A[st - 1][j]) * kv[j][c];
+    }
+  return out;
+}
+
+}  // namespace
+
+TEST(Rkng, CatalogHoldsTheGeneralPairsWithTheirOrders) {
+  const auto pairs = general_pairs();
+  ASSERT_EQ(pairs.size(), 3u);
+  EXPECT_EQ(pairs[0].first, "DOP853-adaptive");
+  EXPECT_EQ(pairs[1].first, "Fine4-adaptive");
+  EXPECT_EQ(pairs[2].first, "Fine5-adaptive");
+  for (const auto& [name, t] : pairs) {
+    const MethodDef& d = resolve_method(name);
+    EXPECT_TRUE(d.info.velocity && d.info.adaptive) << name;
+    EXPECT_EQ(d.info.order, t.general_order) << name;
+    EXPECT_LT(t.general_embedded_order, t.general_order) << name;
+    // Consistency: the stage nodes are the row sums of the velocity coefficients (the stage times); the
+    // weights integrate constants. (Half the squares of the nodes are the row sums of the position
+    // coefficients only for pairs built with that condition, Fine's; in DOP853's Nystrom form, A^2, they are
+    // sum_k a_ik c_k.)
+    const LD tol = std::numeric_limits<LD>::epsilon() * 64 * (d.info.published_digits ? 1e9L : 1);
+    LD sb = 0, sB = 0;
+    for (std::size_t i = 0; i < t.stages(); ++i) {
+      LD ra = 0, rv = 0, rac = 0;
+      for (std::size_t j = 0; j < i; ++j) {
+        ra += t.a[i][j];
+        rv += t.av[i][j];
+        rac += t.av[i][j] * t.c[j];
+      }
+      EXPECT_NEAR(static_cast<double>(rv), static_cast<double>(t.c[i]), static_cast<double>(tol)) << name << i;
+      EXPECT_NEAR(static_cast<double>(ra), static_cast<double>(name == "DOP853-adaptive" ? rac : t.c[i] * t.c[i] / 2),
+                  static_cast<double>(tol))
+          << name << i;
+      sb += t.b[i];
+      sB += t.B[i];
+    }
+    EXPECT_NEAR(static_cast<double>(sb), 0.5, static_cast<double>(tol)) << name;
+    EXPECT_NEAR(static_cast<double>(sB), 1.0, static_cast<double>(tol)) << name;
+  }
+  // Stages and forces per step (first same as last: Fine5 and DOP853 reuse their last force).
+  EXPECT_EQ(resolve_method("Fine4-adaptive").info.forces_per_step, 5);
+  EXPECT_EQ(resolve_method("Fine5-adaptive").info.forces_per_step, 6);
+  EXPECT_EQ(resolve_method("DOP853-adaptive").info.forces_per_step, 12);
+  EXPECT_TRUE(resolve_method("DOP853").info.fsal);
+  EXPECT_EQ(resolve_method("RKNG5(4)").info.name, "Fine5-adaptive");
+}
+
+// The order test of the general pairs: the observed order of the main and of the embedded weights on a
+// velocity-dependent force, in positions and velocities, forward and backward in time (h < 0), from
+// n and 2n steps over |t| = 2 (n = 16 for DOP853, 32 for Fine's pairs: errors between 1e-8 and 3e-17, above
+// the rounding of long double, 1e-19 per step) against DOP853 with 1536 steps.
+TEST(Rkng, EveryGeneralPairHasItsOrderOnAVelocityDependentForceBothDirections) {
+  const auto pairs = general_pairs();
+  const RknTableau<LD>& dop = pairs[0].second;
+  for (const LD dir : {1.0L, -1.0L}) {
+    const State<V2> ref = rkng_run(dop, false, dir * 2.0L / 1536, 1536);
+    for (const auto& [name, t] : pairs)
+      for (const bool embedded : {false, true}) {
+        const int p = embedded ? t.general_embedded_order : t.general_order;
+        double eq[2], ev[2];
+        for (int k = 0; k < 2; ++k) {
+          const long n = (t.general_order >= 8 ? 16L : 32L) << k;
+          const State<V2> s = rkng_run(t, embedded, dir * 2.0L / n, n);
+          eq[k] = std::hypot(static_cast<double>(s.q[0] - ref.q[0]), static_cast<double>(s.q[1] - ref.q[1]));
+          ev[k] = std::hypot(static_cast<double>(s.v[0] - ref.v[0]), static_cast<double>(s.v[1] - ref.v[1]));
+        }
+        const double oq = std::log2(eq[0] / eq[1]), ov = std::log2(ev[0] / ev[1]);
+        std::printf("%-16s %s dir %+.0f: order %d observed q %.2f v %.2f (errors %.1e %.1e)\n", name.c_str(),
+                    embedded ? "embedded" : "main    ", static_cast<double>(dir), p, oq, ov, eq[1], ev[1]);
+        EXPECT_NEAR(oq, p, 0.35) << name << (embedded ? " embedded" : "") << " dir " << static_cast<double>(dir);
+        EXPECT_NEAR(ov, p, 0.35) << name << (embedded ? " embedded" : "") << " dir " << static_cast<double>(dir);
+      }
+  }
+}
+
+// The Nystrom form of DOP853 (position coefficients A^2, weights b A) is the Runge-Kutta method itself on the
+// first-order system: one step of each agrees to rounding, positions and velocities.
+TEST(Rkng, Dop853NystromFormIsTheRungeKuttaMethodOnTheFirstOrderSystem) {
+  const auto pairs = general_pairs();
+  for (const LD h : {0.3L, -0.2L}) {
+    const State<V2> a = rkng_run(pairs[0].second, false, h, 1);
+    const State<V2> b = dop853_first_order_step(kPendulumStart, h);
+    EXPECT_LT(max_error(a, b), 1e-17) << static_cast<double>(h);
+  }
+}
+
+// A first-same-as-last pair evaluates its last stage at the step's solution (q, v) and reuses it: n steps
+// cost 1 + n (s - 1) forces, and the reused force is that of the state the step starts from.
+TEST(Rkng, FirstSameAsLastReusesTheForceOfTheStepEnd) {
+  for (const auto& [name, t] : general_pairs()) {
+    long calls = 0;
+    RknTableau<LD> main = t;
+    main.bhat.clear();
+    main.Bhat.clear();
+    main.blow.clear();
+    main.Blow.clear();
+    auto counted = [&calls](const V2& q, const V2& v, V2& a) {
+      ++calls;
+      DraggedPendulum{}(q, v, a);
+    };
+    RknStepper<V2, decltype(counted)> st(main, counted);
+    State<V2> s = kPendulumStart;
+    st.integrate(s, 0.01L, 10);
+    const long per_step = static_cast<long>(t.stages()) - (t.fsal() ? 1 : 0);
+    EXPECT_EQ(calls, t.fsal() ? 1 + 10 * per_step : 10 * per_step) << name;
+    // A state changed between calls is not mistaken for the step end: a fresh velocity means a fresh force.
+    const long before = calls;
+    s.v[0] += 0.1L;
+    st.integrate(s, 0.01L, 1);
+    EXPECT_EQ(calls - before, static_cast<long>(t.stages())) << name;
+  }
+}
+
+// A tableau without velocity coefficients refuses a velocity-dependent force; the adaptive engine runs a
+// general pair on one, and its error follows the tolerance.
+TEST(Rkng, AdaptivePairsFollowTheToleranceAndRknTableauxRefuseTheForce) {
+  const auto dp12 = convert_tableau<LD>(std::get<RknTableau<bigcomplex>>(resolve_method("DP12").build()),
+                                        [](const bigcomplex& x) { return to_scalar<LD>(x); });
+  EXPECT_THROW((RknStepper<V2, DraggedPendulum>(dp12, DraggedPendulum{})), std::invalid_argument);
+  const auto pairs = general_pairs();
+  const State<V2> ref = rkng_run(pairs[0].second, false, 2.0L / 1536, 1536);
+  for (const auto& [name, t] : pairs) {
+    double err[2];
+    long evals[2];
+    for (int k = 0; k < 2; ++k) {
+      AdaptiveOptions o;
+      o.rtol = o.atol = k == 0 ? 1e-6 : 1e-9;
+      if (k == 1) o.h0 = 1.0;  // a first step far too long: rejected
+      AdaptiveRknIntegrator<V2, DraggedPendulum> ai(t, DraggedPendulum{}, o);
+      // DOP853's stretched estimate (orders 5 and 3 combined) is controlled as an error of order 7.
+      EXPECT_EQ(ai.error_order(), t.blow.empty() ? t.general_embedded_order : t.general_order - 1) << name;
+      EXPECT_EQ(ai.method_order(), t.general_order) << name;
+      State<V2> s = kPendulumStart;
+      const AdaptiveStats st = ai.integrate_to(s, 0.0L, 2.0L);
+      err[k] = max_error(s, ref);
+      evals[k] = st.force_evals;
+      // Two forces for the first step size (unless given); every attempted step its stages, less the first force where
+      // the pair reuses it (from the last step's end, or from its start after a rejection).
+      const long s_ = static_cast<long>(t.stages()), attempts = st.accepted + st.rejected;
+      const long start = k == 0 ? 2 : 0;
+      EXPECT_EQ(st.force_evals, t.fsal() ? start + s_ + (attempts - 1) * (s_ - 1) : start + attempts * s_) << name;
+      if (k == 1) {
+        EXPECT_GE(st.rejected, 1) << name;
+      }
+    }
+    std::printf("%-16s tol 1e-6 -> 1e-9: error %.2e -> %.2e, forces %ld -> %ld\n", name.c_str(), err[0], err[1],
+                evals[0], evals[1]);
+    EXPECT_LT(err[0], 1e-6) << name;
+    EXPECT_LT(err[1], 1e-9) << name;
+    EXPECT_GT(err[0], 1e-6 * 1e-4) << name;  // not a controller that ignores the tolerance
+    EXPECT_GT(evals[1], evals[0]) << name;
+  }
+}
+
+// DOP853's stretched estimate: the third-order weights are a solution of order 3 (observed on the velocity-
+// dependent force), and the combined estimate err5^2 / sqrt(err5^2 + 0.01 err3^2) of one step shrinks like
+// h^12 / h^4 = h^8 (the controller's exponent 1/8, error order 7): halving the step divides it by about 2^8.
+TEST(Rkng, Dop853StretchedEstimateHasTheOrderOfTheMainSolution) {
+  const auto pairs = general_pairs();
+  RknTableau<LD> t = pairs[0].second;
+  ASSERT_FALSE(t.blow.empty());
+  {
+    RknTableau<LD> low = t;
+    low.bhat = low.blow;
+    low.Bhat = low.Blow;
+    low.blow.clear();
+    low.Blow.clear();
+    const State<V2> ref = rkng_run(t, false, 2.0L / 1536, 1536);
+    double e[2];
+    for (int k = 0; k < 2; ++k) {
+      const long n = 64L << k;
+      const State<V2> s = rkng_run(low, true, 2.0L / n, n);
+      e[k] = max_error(s, ref);
+    }
+    EXPECT_NEAR(std::log2(e[0] / e[1]), 3, 0.35);
+  }
+  RknTableau<LD> full = pairs[0].second;
+  RknStepper<V2, DraggedPendulum> st(full, DraggedPendulum{});
+  auto stretched = [&](LD h) {
+    State<V2> y = kPendulumStart, err;
+    st.step_with_error(y, h, err);
+    auto norm = [](const State<V2>& x) {
+      return std::sqrt(static_cast<double>(x.q[0] * x.q[0] + x.q[1] * x.q[1] + x.v[0] * x.v[0] + x.v[1] * x.v[1]));
+    };
+    const double e5 = norm(err), e3 = norm(st.low_error());
+    return e5 * e5 / std::sqrt(e5 * e5 + 0.01 * e3 * e3);
+  };
+  const double r = std::log2(stretched(0.1L) / stretched(0.05L));
+  std::printf("DOP853 stretched estimate: it shrinks like h^%.2f\n", r);
+  EXPECT_NEAR(r, 8, 0.35);
 }

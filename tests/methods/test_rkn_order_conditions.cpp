@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <complex>
+#include <cstdio>
 #include <map>
 #include <random>
 #include <string>
@@ -228,7 +229,12 @@ TEST(RknOrderConditions, EveryCatalogTableauHasExactlyItsDeclaredOrder) {
     const auto r = residuals_by_order(*t, p + 1);
     EXPECT_LE(*std::max_element(r.begin(), r.end() - 1), tol)
         << d.info.name << ": a condition of order <= " << p << " fails";
-    EXPECT_GT(r.back(), 1e3 * tol) << d.info.name << " satisfies the conditions of order " << p + 1;
+    // A general (RKNG) pair's order is that for y'' = f(t, y, y'), whose conditions include these: on
+    // y'' = f(y) it may be higher (its order on f(y, y') is measured in test_adaptive_rkn, Rkng.*).
+    if (!t->general()) {
+      EXPECT_GT(r.back(), 1e3 * tol) << d.info.name << " satisfies the conditions of order " << p + 1;
+    }
+    std::printf("%-16s order %d: residuals of order %d %.1e\n", d.info.name.c_str(), p, p + 1, r.back());
     ++checked;
   }
   EXPECT_GE(checked, 5);  // N4, M4-RKN, M6-5F, A6, Aprime at least

@@ -1,5 +1,5 @@
-"""Velocity-dependent forces force(t, q, v) and first-order systems (nystrom.solve_ivp): GBS against exact
-solutions (positions and velocities, both directions), the Arenstorf orbit, events and dense output on a
+"""Velocity-dependent forces force(t, q, v) and first-order systems (nystrom.solve_ivp): GBS and the general RKN
+pairs (DOP853, Fine's) against exact solutions (positions and velocities, both directions), the Arenstorf orbit, events and dense output on a
 first-order system, and the one-line refusal of the other methods (the C++ solve()'s text)."""
 import math
 
@@ -57,13 +57,33 @@ def test_arenstorf_closes_after_one_period():
     assert res.force_evals > 0
 
 
+@pytest.mark.parametrize("method", ["DOP853", "Fine5-adaptive"])
+def test_general_rkn_pairs_both_directions_and_on_a_first_order_system(method):
+    res = nystrom.solve(damped, [1.0], [0.0], t_span=(0, 8), method=method, rtol=1e-11)
+    q, v = damped_exact(1.0, 0.0, 8.0)
+    assert abs(res.q[-1][0] - q) < 1e-9
+    assert abs(res.v[-1][0] - v) < 1e-9
+    back = nystrom.solve(damped, [q], [v], t_span=(8, 0), method=method, rtol=1e-11)
+    assert back.t[-1] == 0
+    assert abs(back.q[-1][0] - 1.0) < 1e-8
+    assert abs(back.v[-1][0]) < 1e-8
+    info = nystrom.method_info(method)
+    assert info["velocity"] and info["adaptive"]
+    # y' = -y + cos t as a first-order system (scipy's convention), against its exact solution.
+    r = nystrom.solve_ivp(lambda t, y: -y + np.cos(t), (0, 5), [1.0], method=method, rtol=1e-10, atol=1e-10)
+    exact = 0.5 * (np.cos(5.0) + np.sin(5.0)) + 0.5 * np.exp(-5.0)
+    assert r.success
+    assert abs(r.y[0, -1] - exact) < 1e-8
+
+
 def test_other_methods_are_refused_with_the_libraries_line():
     for method, kw in (("M8", dict(steps=100)), ("DP12-adaptive", dict(rtol=1e-8))):
         name = nystrom.method_info(method)["name"]
         with pytest.raises(ValueError) as e:
             nystrom.solve(arenstorf, Q0, V0, t_span=(0, 1), method=method, **kw)
         assert str(e.value) == (f"method '{name}' does not support velocity-dependent forces a(t, q, v); "
-                                "methods that do: GBS, mpe-midpoint:K1,K2,...")
+                                "methods that do: DOP853-adaptive, Fine4-adaptive, Fine5-adaptive, GBS, "
+                                "mpe-midpoint:K1,K2,...")
 
 
 def test_solve_ivp_dense_output_and_events():
@@ -103,5 +123,6 @@ def test_solve_ivp_van_der_pol_period():
 
 def test_solve_ivp_refuses_other_methods():
     with pytest.raises(ValueError, match="^method 'M8' does not integrate first-order systems y' = f\\(t, y\\); "
-                                         "methods that do: GBS, mpe-midpoint:K1,K2,...$"):
+                                         "methods that do: DOP853-adaptive, Fine4-adaptive, Fine5-adaptive, "
+                                         "GBS, mpe-midpoint:K1,K2,...$"):
         nystrom.solve_ivp(lambda t, y: -y, (0, 1), [1.0], method="M8")

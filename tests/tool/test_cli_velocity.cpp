@@ -32,6 +32,24 @@ TEST(CliVelocity, ArenstorfReturnErrorFollowsTheTolerance) {
   EXPECT_LT(j12.at("jacobi_error").get<double>(), 1e-8);
 }
 
+TEST(CliVelocity, GeneralRknPairsRunTheArenstorfContract) {
+  // Any method for velocity-dependent forces can be named: DOP853 (by its alias) and Fine's pairs.
+  for (const char* m : {"DOP853", "Fine5-adaptive", "Fine4-adaptive"}) {
+    const auto r = run(std::string("run --problem arenstorf --method ") + m + " --tol 1e-10 --periods 1 --json");
+    ASSERT_EQ(r.code, 0) << m << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_LT(j.at("return_error").get<double>(), 1e-6) << m;
+    EXPECT_GT(j.at("force_evals").get<long>(), 0) << m;
+    EXPECT_EQ(j.at("adaptive").get<bool>(), true) << m;
+  }
+  const auto dop = nlohmann::json::parse(run("run --problem arenstorf --method DOP853 --tol 1e-10 --json").out);
+  EXPECT_EQ(dop.at("method").get<std::string>(), "DOP853-adaptive");
+  // Without a tolerance: exit 2, one line.
+  const auto nt = run("run --problem arenstorf --method DOP853");
+  EXPECT_EQ(nt.code, 2);
+  EXPECT_EQ(nt.err.find('\n'), nt.err.size() - 1) << nt.err;
+}
+
 TEST(CliVelocity, DampedOscillatorAgainstItsExactSolution) {
   const auto r = run("run --problem damped-oscillator --method GBS --tol 1e-11 --periods 3 --json");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -50,7 +68,8 @@ TEST(CliVelocity, MethodsForAccelerationsOnlyAreRefusedWithOneLine) {
     EXPECT_EQ(r.err.find("nystrom: error: method '"), 0u) << r.err;
     EXPECT_NE(
         r.err.find(
-            "does not support velocity-dependent forces a(t, q, v); methods that do: GBS, mpe-midpoint:K1,K2,...\n"),
+            "does not support velocity-dependent forces a(t, q, v); methods that do: DOP853-adaptive, Fine4-adaptive, "
+            "Fine5-adaptive, GBS, mpe-midpoint:K1,K2,...\n"),
         std::string::npos)
         << r.err;
     EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;  // one line

@@ -13,6 +13,8 @@
 //   st.accepted, st.rejected, st.force_evals, st.last_h                 // this call; ai.total() sums all calls
 //
 // V is std::array<T, N> or std::vector<T> with a real T (double, long double, float128, ...).
+// A general (RKNG) pair (RknTableau::general(), e.g. "Fine5-adaptive") also takes a velocity-dependent force
+// force(q, v, a).
 // Errors: std::invalid_argument for bad input (rtol or atol negative or not finite, both zero, rtol
 // below 10 eps of the scalar type, t1 < t0, t0/t1 not finite,
 // NaN/inf or inconsistent state, a tableau without embedded weights, bad options);
@@ -83,9 +85,17 @@ class AdaptiveRknIntegrator {
         compensated_(use_compensation<scalar_type>(eopt.compensated)) {
     opt_.validate();
     adaptive_detail::check_tolerance<real_type>(opt_);
-    if (opt_.error_order == 0) opt_.error_order = embedded_order(stepper_.tableau());
+    // A general (RKNG) tableau carries its orders for y'' = f(t, y, y'); the order conditions of
+    // y'' = f(y) decide those of the others.
+    const auto& tab = stepper_.tableau();
+    // With a second, lower-order estimate (DOP853) the stretched error behaves like that of the main solution.
+    if (opt_.error_order == 0)
+      opt_.error_order = !tab.blow.empty() ? tab.general_order - 1
+                         : tab.general()   ? tab.general_embedded_order
+                                           : embedded_order(tab);
     if (opt_.error_order < 1) throw std::invalid_argument("the embedded weights of the tableau have no order");
-    const int high = tableau_order(stepper_.tableau());
+    const int high = tab.general() ? tab.general_order : tableau_order(tab);
+    stretched_ = !tab.blow.empty();
     method_order_ = high > 0 ? high : opt_.error_order;
   }
 
@@ -149,8 +159,13 @@ class AdaptiveRknIntegrator {
       } else {
         stepper_.step_with_error(y, h, err);
       }
-      // The controller works in double: 2 digits suffice.
-      const double e = adaptive_detail::error_norm(s, y, err, err_scale);
+      // The controller works in double: 2 digits suffice. With a second estimate of lower order (DOP853's),
+      // Hairer's stretched estimate err5^2 / sqrt(err5^2 + 0.01 err3^2) (HNW I, sec. II.10).
+      double e = adaptive_detail::error_norm(s, y, err, err_scale);
+      if (stretched_ && e > 0) {
+        const double e3 = adaptive_detail::error_norm(s, y, stepper_.low_error(), err_scale);
+        e = e * e / std::sqrt(e * e + 0.01 * e3 * e3);
+      }
       error_finite = e < std::numeric_limits<double>::infinity();
       if (e <= 1.0) {
         assign_state(s, y);
@@ -213,6 +228,7 @@ class AdaptiveRknIntegrator {
   RknStepper<V, Force> stepper_;
   int method_order_ = 0;
   bool compensated_ = false;
+  bool stretched_ = false;  // the tableau has a second estimate (blow, Blow)
   real_type h_next_ = real_type(0);
   AdaptiveResumePoint<real_type> resume_;
   AdaptiveStats total_;

@@ -6,9 +6,14 @@
 //
 // Any explicit RKN tableau runs here, including the force-consolidated methods of the Chin
 // paper (Nyström 4, M4, the 5-force M6, Albrecht A6, A'), which are tableaux too.
-// First-same-as-last is detected from the tableau (stage 1 at q_n, last stage at q_{n+1})
-// and the reused force is checked against the position it was evaluated at.
+// First-same-as-last is detected from the tableau (stage 1 at q_n, last stage at q_{n+1}): the last
+// stage is evaluated at the step's result itself, and the reused force is checked against the state it
+// was evaluated at.
 // An optional embedded solution (bhat, Bhat) gives an error estimate for step control.
+//
+// A general (RKNG) tableau (RknTableau::general()) also integrates a velocity-dependent force,
+// force(q, v, a): the stages are evaluated at (y_i, w_i) with w_i = v_n + h sum_{j<i} av_ij f_j
+// (Hairer, Norsett & Wanner I, sec. II.14). A tableau without velocity coefficients refuses such a force.
 #pragma once
 
 #include <cstddef>
@@ -30,14 +35,25 @@ class RknStepper {
   using scalar_type = typename V::value_type;
   using real_type = real_t<scalar_type>;
 
+  /// Whether the force takes the velocity (force(q, v, a)).
+  static constexpr bool velocity_dependent =
+      std::is_invocable_v<Force&, const V&, const V&, V&> && !std::is_invocable_v<Force&, const V&, V&>;
+
   RknStepper(RknTableau<scalar_type> t, Force force, EngineOptions opt = {})
       : t_(std::move(t)), force_(std::move(force)), opt_(opt) {
     t_.validate();
+    if (velocity_dependent && !t_.general())
+      throw std::invalid_argument(
+          "this RKN tableau has no velocity coefficients: it cannot integrate a velocity-dependent force");
     fsal_ = t_.fsal();
     const std::size_t s = t_.stages();
+    // For a velocity-dependent force the last stage is at (q_{n+1}, v_{n+1}) only if its velocity weight is 0.
+    if (velocity_dependent && fsal_ && !(t_.B[s - 1] == scalar_type(0))) fsal_ = false;
     for (std::size_t i = 0; i < s; ++i)
-      for (std::size_t j = 0; j < i; ++j)
+      for (std::size_t j = 0; j < i; ++j) {
         if (!(t_.a[i][j] == scalar_type(0))) nz_.push_back({i, j, t_.a[i][j]});
+        if (velocity_dependent && !(t_.av[i][j] == scalar_type(0))) nzv_.push_back({i, j, t_.av[i][j]});
+      }
     f_.resize(s);
   }
 
@@ -78,6 +94,8 @@ class RknStepper {
   /// The same, the increments added to s with compensated summation with the carries of comp (the caller
   /// keeps the carries of the last accepted step).
   void step_with_error(State<V>& s, real_type h, State<V>& err, Compensator<V>& comp) { one_step(s, h, &err, &comp); }
+  /// The second (lower-order) error estimate of the last step_with_error, for a tableau with blow, Blow.
+  const State<V>& low_error() const { return err_low_; }
 
  private:
   struct Nz {
@@ -94,17 +112,92 @@ class RknStepper {
     constexpr bool local = is_std_array<V>::value;
     std::conditional_t<local, V, V&> y = y_, dq = dq_, dv = dv_;
     const bool project = is_complex_v<scalar_type> && !opt_.keep_complex;
-    std::size_t k = 0;  // index into nz_, ordered by stage
-    for (std::size_t i = 0; i < s; ++i) {
-      if (i == 0 && fsal_ && cache_valid_ && same(aq_, st.q)) {
-        while (k < nz_.size() && nz_[k].i == 0) ++k;
-        continue;  // f_[0] already holds the force at q_n
+    std::size_t k = 0, kv = 0;  // indices into nz_ and nzv_, ordered by stage
+    if constexpr (velocity_dependent) resize_like(w_, st.v);
+    // First same as last: the last stage is the step's result (q_{n+1}, and v_{n+1} for a velocity-dependent
+    // force), so it is evaluated there, after the update: the force reused by the next step is then that of the
+    // state itself, and a run restarted from a checkpoint (which holds the state, not the force) recomputes it
+    // bitwise.
+    const bool at_end = fsal_ && !project;
+    const std::size_t ns = at_end ? s - 1 : s;
+    for (std::size_t i = 0; i < ns; ++i) {
+      if (i == 0 && fsal_ && cache_valid_) {
+        // f_[0] holds the force at the end of the last step, f_[s-1] the one at its start (a step that the
+        // controller rejected starts there again).
+        bool reuse = same(aq_, st.q) && (!velocity_dependent || same(av_, st.v));
+        if (!reuse && same(sq_, st.q) && (!velocity_dependent || same(sv_, st.v))) {
+          std::swap(f_[0], f_[s - 1]);
+          reuse = true;
+        }
+        if (reuse) {
+          while (k < nz_.size() && nz_[k].i == 0) ++k;
+          while (kv < nzv_.size() && nzv_[kv].i == 0) ++kv;
+          continue;  // f_[0] already holds the force at (q_n, v_n)
+        }
       }
       assign(y, st.q);
       if (!(t_.c[i] == scalar_type(0))) axpy(y, t_.c[i] * h, st.v);
       for (; k < nz_.size() && nz_[k].i == i; ++k) axpy(y, nz_[k].a * h2, f_[nz_[k].j]);
-      force_(y, f_[i]);
+      if constexpr (velocity_dependent) {
+        assign(w_, st.v);
+        for (; kv < nzv_.size() && nzv_[kv].i == i; ++kv) axpy(w_, nzv_[kv].a * h, f_[nzv_[kv].j]);
+        force_(static_cast<const V&>(y), static_cast<const V&>(w_), f_[i]);
+      } else {
+        force_(y, f_[i]);
+      }
       ++evals_;
+    }
+    if (at_end) {  // the start of the step, whose force f_[0] is kept (see the stage loop)
+      resize_like(sq_, st.q);
+      assign(sq_, st.q);
+      if constexpr (velocity_dependent) {
+        resize_like(sv_, st.v);
+        assign(sv_, st.v);
+      }
+    }
+    // The increments: q's first (b_s = 0 for a first-same-as-last tableau), then, for a force of the position
+    // only, the last stage at q_{n+1} and v's with it; for a velocity-dependent force v's first (B_s = 0 is
+    // required, see the constructor) and the last stage at (q_{n+1}, v_{n+1}).
+    auto last_stage = [&] {
+      if constexpr (velocity_dependent)
+        force_(static_cast<const V&>(st.q), static_cast<const V&>(st.v), f_[s - 1]);
+      else
+        force_(static_cast<const V&>(st.q), f_[s - 1]);
+      ++evals_;
+    };
+    const bool v_first = at_end && velocity_dependent;
+    if (comp) {
+      // One increment per step for q and for v, added with compensation.
+      resize_like(dq, st.q);
+      resize_like(dv, st.q);
+      for (std::size_t j = 0; j < st.q.size(); ++j) {
+        dq[j] = scalar_type(0);
+        dv[j] = scalar_type(0);
+      }
+      for (std::size_t i = 0; i < ns; ++i)
+        if (!(t_.b[i] == scalar_type(0))) axpy(dq, t_.b[i] * h2, f_[i]);
+      axpy(dq, h, st.v);
+      if (v_first) {
+        for (std::size_t i = 0; i < ns; ++i)
+          if (!(t_.B[i] == scalar_type(0))) axpy(dv, t_.B[i] * h, f_[i]);
+        comp->add_q(st.q, dq);
+        comp->add_v(st.v, dv);
+        last_stage();
+      } else {
+        comp->add_q(st.q, dq);
+        if (at_end) last_stage();
+        for (std::size_t i = 0; i < s; ++i)
+          if (!(t_.B[i] == scalar_type(0))) axpy(dv, t_.B[i] * h, f_[i]);
+        comp->add_v(st.v, dv);
+      }
+    } else {
+      axpy(st.q, h, st.v);
+      for (std::size_t i = 0; i < ns; ++i)
+        if (!(t_.b[i] == scalar_type(0))) axpy(st.q, t_.b[i] * h2, f_[i]);
+      if (at_end && !v_first) last_stage();
+      for (std::size_t i = 0; i < (v_first ? ns : s); ++i)
+        if (!(t_.B[i] == scalar_type(0))) axpy(st.v, t_.B[i] * h, f_[i]);
+      if (v_first) last_stage();
     }
     if (err) {
       resize_like(err->q, st.q);
@@ -116,28 +209,16 @@ class RknStepper {
           axpy(err->q, (t_.b[i] - t_.bhat[i]) * h2, f_[i]);
           axpy(err->v, (t_.B[i] - t_.Bhat[i]) * h, f_[i]);
         }
-    }
-    if (comp) {
-      // One increment per step for q and for v, added with compensation.
-      resize_like(dq, st.q);
-      resize_like(dv, st.q);
-      for (std::size_t j = 0; j < st.q.size(); ++j) {
-        dq[j] = scalar_type(0);
-        dv[j] = scalar_type(0);
+      if (!t_.blow.empty()) {
+        resize_like(err_low_.q, st.q);
+        resize_like(err_low_.v, st.q);
+        for (auto& e : err_low_.q) e = scalar_type(0);
+        for (auto& e : err_low_.v) e = scalar_type(0);
+        for (std::size_t i = 0; i < s; ++i) {
+          axpy(err_low_.q, (t_.b[i] - t_.blow[i]) * h2, f_[i]);
+          axpy(err_low_.v, (t_.B[i] - t_.Blow[i]) * h, f_[i]);
+        }
       }
-      for (std::size_t i = 0; i < s; ++i)
-        if (!(t_.b[i] == scalar_type(0))) axpy(dq, t_.b[i] * h2, f_[i]);
-      axpy(dq, h, st.v);
-      for (std::size_t i = 0; i < s; ++i)
-        if (!(t_.B[i] == scalar_type(0))) axpy(dv, t_.B[i] * h, f_[i]);
-      comp->add_q(st.q, dq);
-      comp->add_v(st.v, dv);
-    } else {
-      axpy(st.q, h, st.v);
-      for (std::size_t i = 0; i < s; ++i)
-        if (!(t_.b[i] == scalar_type(0))) axpy(st.q, t_.b[i] * h2, f_[i]);
-      for (std::size_t i = 0; i < s; ++i)
-        if (!(t_.B[i] == scalar_type(0))) axpy(st.v, t_.B[i] * h, f_[i]);
     }
     if (project) {
       project_real(st.q);
@@ -147,12 +228,15 @@ class RknStepper {
         project_real(comp->cv);
       }
     }
-    if (fsal_ && !project) {
-      // The last stage was evaluated at q_{n+1} up to rounding; reuse it exactly as the
-      // method prescribes (the tableau says y_s = q_{n+1}).
+    if (at_end) {
+      // The last stage was evaluated at the step's result: the next step's first force.
       std::swap(f_[0], f_[s - 1]);
       resize_like(aq_, st.q);
       assign(aq_, st.q);
+      if constexpr (velocity_dependent) {
+        resize_like(av_, st.v);
+        assign(av_, st.v);
+      }
       cache_valid_ = true;
     } else {
       cache_valid_ = false;
@@ -170,12 +254,14 @@ class RknStepper {
   Force force_;
   EngineOptions opt_;
   bool fsal_ = false;
-  std::vector<Nz> nz_;
+  std::vector<Nz> nz_, nzv_;
   std::vector<V> f_;
-  V y_{};
-  V aq_{};
+  V y_{}, w_{};
+  V aq_{}, av_{};  // the end of the last step (its force is f_[0])
+  V sq_{}, sv_{};  // its start (its force is f_[s-1])
   V dq_{}, dv_{};
   Compensator<V> comp_;
+  State<V> err_low_;
   bool cache_valid_ = false;
   long evals_ = 0;
 };

@@ -106,7 +106,12 @@ R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const ErrorSca
   using std::abs;
   const std::size_t n = s.q.size();
   V a0 = s.q, a1 = s.q;
-  force(s.q, a0);
+  // A velocity-dependent force (force(q, v, a)) is evaluated at (q0, v0) and at the Euler step (q1, v1).
+  constexpr bool vd = std::is_invocable_v<F&, const V&, const V&, V&> && !std::is_invocable_v<F&, const V&, V&>;
+  if constexpr (vd)
+    force(s.q, s.v, a0);
+  else
+    force(s.q, a0);
   auto norm = [&](auto&& comp) {
     double sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -125,7 +130,13 @@ R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const ErrorSca
   const R h0(h0d);
   V q1 = s.q;
   for (std::size_t i = 0; i < n; ++i) q1[i] = s.q[i] + h0 * s.v[i];
-  force(q1, a1);
+  if constexpr (vd) {
+    V v1 = s.v;
+    for (std::size_t i = 0; i < n; ++i) v1[i] = s.v[i] + h0 * a0[i];
+    force(static_cast<const V&>(q1), static_cast<const V&>(v1), a1);
+  } else {
+    force(q1, a1);
+  }
   const double d2 = norm([&](std::size_t i) { return std::pair<R, R>(h0 * a0[i], a1[i] - a0[i]); }) / h0d;
   const double dm = std::max(d1, d2);
   const double h1 = dm <= 1e-15 ? std::max(1e-6, h0d * 1e-3) : std::pow(0.01 / dm, 1.0 / (order + 1));

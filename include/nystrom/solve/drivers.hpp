@@ -341,7 +341,19 @@ struct Run {
   typename DenseOutput<V>::PartialStep propagated_method(const MethodDef& def) const {
     using T = real_t<typename VE::value_type>;
     const MethodData data = method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
-    return partial_step(Integrator<VE, Force>(data, force(), detail::engine_options(opt)));
+    if constexpr (Force::VD) {
+      // A velocity-dependent force: the main weights of the general RKN pair (the one adaptive family for it).
+      RknTableau<bigcomplex> t = std::get<RknTableau<bigcomplex>>(data);
+      t.bhat.clear();
+      t.Bhat.clear();
+      t.blow.clear();
+      t.Blow.clear();
+      auto conv = [](const bigcomplex& x) { return to_scalar<typename VE::value_type>(x); };
+      return partial_step(RknStepper<VE, Force>(convert_tableau<typename VE::value_type>(t, conv), force(),
+                                                detail::engine_options(opt)));
+    } else {
+      return partial_step(Integrator<VE, Force>(data, force(), detail::engine_options(opt)));
+    }
   }
   void check_finite(const V& q, const V& v, const R& ta, const R& tb) const {
     if (!all_finite(q) || !all_finite(v)) throw not_finite(ta, tb);
@@ -752,6 +764,22 @@ inline void check_step_control(const MethodDef& def, const SolveOptions& opt, bo
   if (!std::isfinite(opt.h0) || opt.h0 < 0) throw invalid_input("h0 must be finite and >= 0");
 }
 
+/// The adaptive engines' options from solve()'s.
+inline AdaptiveOptions adaptive_options(const SolveOptions& opt) {
+  AdaptiveOptions ao;
+  ao.rtol = opt.rtol;
+  ao.atol = opt.atol;
+  ao.max_steps = opt.max_steps;
+  ao.h0 = opt.h0;
+  ao.h_max = opt.h_max;
+  ao.safety = opt.safety;
+  ao.fac_min = opt.fac_min;
+  ao.fac_max = opt.fac_max;
+  ao.predictive = opt.predictive;
+  ao.error_order = opt.error_order;
+  return ao;
+}
+
 /// The run of solve_impl with the method's engine, into sol.
 template <class V, class F, class VE>
 void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
@@ -765,27 +793,25 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
       run_fixed<VE>(prob, def, opt, events, sol, dir, resume);
       return;
     }
-    if (!gbs) throw invalid_input(velocity_refusal(def.info.name));
+    if (!gbs && !def.info.adaptive) throw invalid_input(velocity_refusal(def.info.name));
     check_tolerances(def, opt);
     Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
-    run_gbs<VE>(run, def, sol, events, resume);
+    if (gbs) {
+      run_gbs<VE>(run, def, sol, events, resume);
+    } else {  // a general (RKNG) pair
+      long calls = 0;
+      using Counted = CountingForce<typename Run<V, F, VE>::Force>;
+      auto engine = make_adaptive_integrator<VE>(def, Counted{&calls, run.force()}, adaptive_options(opt),
+                                                 detail::engine_options(opt));
+      run_adaptive<VE>(run, engine, calls, "adaptive-rkn", def, sol, events, resume);
+    }
   } else if (gbs || def.info.adaptive) {
     check_tolerances(def, opt);
     Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
     if (gbs) {
       run_gbs<VE>(run, def, sol, events, resume);
     } else {
-      AdaptiveOptions ao;
-      ao.rtol = opt.rtol;
-      ao.atol = opt.atol;
-      ao.max_steps = opt.max_steps;
-      ao.h0 = opt.h0;
-      ao.h_max = opt.h_max;
-      ao.safety = opt.safety;
-      ao.fac_min = opt.fac_min;
-      ao.fac_max = opt.fac_max;
-      ao.predictive = opt.predictive;
-      ao.error_order = opt.error_order;
+      const AdaptiveOptions ao = adaptive_options(opt);
       long calls = 0;
       using Counted = CountingForce<typename Run<V, F, VE>::Force>;
       if (std::holds_alternative<MpeDef>(def.build())) {
