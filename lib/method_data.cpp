@@ -3,16 +3,49 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
+#include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/method_data.hpp"
 #include "nystrom/methods/refine.hpp"
 
 namespace nystrom {
 
+namespace {
+
+/// Whether `def` is the catalog's entry of its name (the same record): its coefficients are then a function of
+/// the name and the precision, and are built once per precision.
+bool is_catalog_entry(const MethodDef& def) {
+  for (const auto& d : catalog())
+    if (d.info.name == def.info.name)
+      return d.info.family == def.info.family && d.info.order == def.info.order && d.info.source == def.info.source &&
+             d.info.description == def.info.description;
+  return false;
+}
+
+/// def.build() at the current reference precision; for a catalog entry, from a cache (building a table in MPFR
+/// costs 40-220 microseconds, more than a short run of the method).
+MethodData built(const MethodDef& def, unsigned ref) {
+  if (!is_catalog_entry(def)) return def.build();
+  static std::mutex mu;
+  static std::map<std::pair<std::string, unsigned>, MethodData> cache;
+  const auto key = std::make_pair(def.info.name, ref);
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    if (auto it = cache.find(key); it != cache.end()) return it->second;
+  }
+  MethodData data = def.build();
+  std::lock_guard<std::mutex> lock(mu);
+  cache.emplace(key, data);
+  return data;
+}
+
+}  // namespace
+
 MethodData method_data_for(const MethodDef& def, long bits, const std::string& type_name) {
   const unsigned ref = reference_bits(bits);
   BigPrecision guard(ref);
-  MethodData data = def.build();
+  MethodData data = built(def, ref);
   const int digits = def.info.published_digits;
   if (published_digits_suffice(digits, bits)) return data;
   const auto* sp = std::get_if<SplittingScheme<bigcomplex>>(&data);
