@@ -73,6 +73,12 @@ struct State {
   V v;
 };
 
+/// Whether an engine's force takes the velocity, force(q, v, a) (and not force(q, a)): the velocity-dependent
+/// forces that GBS, the general RKN pairs and the first-step estimate call with the stage velocity.
+template <class F, class V>
+inline constexpr bool takes_velocity_v =
+    std::is_invocable_v<F&, const V&, const V&, V&> && !std::is_invocable_v<F&, const V&, V&>;
+
 template <class V>
 struct is_std_array : std::false_type {};
 template <class S, std::size_t N>

@@ -104,8 +104,7 @@ class GbsIntegrator {
   using real_type = real_t<scalar_type>;
   static_assert(!is_complex_v<scalar_type>, "GBS works on real states");
   /// Whether the force takes the velocity (force(q, v, a)): the modified midpoint base.
-  static constexpr bool velocity_dependent =
-      std::is_invocable_v<F&, const V&, const V&, V&> && !std::is_invocable_v<F&, const V&, V&>;
+  static constexpr bool velocity_dependent = takes_velocity_v<F, V>;
 
   GbsIntegrator(F force, GbsOptions opt = {}) : force_(std::move(force)), opt_(opt) {
     if (opt_.max_columns < 3 || opt_.max_columns > 30)

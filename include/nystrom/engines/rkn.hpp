@@ -36,8 +36,7 @@ class RknStepper {
   using real_type = real_t<scalar_type>;
 
   /// Whether the force takes the velocity (force(q, v, a)).
-  static constexpr bool velocity_dependent =
-      std::is_invocable_v<Force&, const V&, const V&, V&> && !std::is_invocable_v<Force&, const V&, V&>;
+  static constexpr bool velocity_dependent = takes_velocity_v<Force, V>;
 
   RknStepper(RknTableau<scalar_type> t, Force force, EngineOptions opt = {})
       : t_(std::move(t)), force_(std::move(force)), opt_(opt) {
@@ -200,25 +199,20 @@ class RknStepper {
       if (v_first) last_stage();
     }
     if (err) {
-      resize_like(err->q, st.q);
-      resize_like(err->v, st.q);
-      for (auto& e : err->q) e = scalar_type(0);
-      for (auto& e : err->v) e = scalar_type(0);
-      if (!t_.bhat.empty())
-        for (std::size_t i = 0; i < s; ++i) {
-          axpy(err->q, (t_.b[i] - t_.bhat[i]) * h2, f_[i]);
-          axpy(err->v, (t_.B[i] - t_.Bhat[i]) * h, f_[i]);
-        }
-      if (!t_.blow.empty()) {
-        resize_like(err_low_.q, st.q);
-        resize_like(err_low_.v, st.q);
-        for (auto& e : err_low_.q) e = scalar_type(0);
-        for (auto& e : err_low_.v) e = scalar_type(0);
-        for (std::size_t i = 0; i < s; ++i) {
-          axpy(err_low_.q, (t_.b[i] - t_.blow[i]) * h2, f_[i]);
-          axpy(err_low_.v, (t_.B[i] - t_.Blow[i]) * h, f_[i]);
-        }
-      }
+      // The difference of the main solution and an embedded one (weights wq, wv; none: zero).
+      auto difference = [&](State<V>& e, const std::vector<scalar_type>& wq, const std::vector<scalar_type>& wv) {
+        resize_like(e.q, st.q);
+        resize_like(e.v, st.q);
+        for (auto& x : e.q) x = scalar_type(0);
+        for (auto& x : e.v) x = scalar_type(0);
+        if (!wq.empty())
+          for (std::size_t i = 0; i < s; ++i) {
+            axpy(e.q, (t_.b[i] - wq[i]) * h2, f_[i]);
+            axpy(e.v, (t_.B[i] - wv[i]) * h, f_[i]);
+          }
+      };
+      difference(*err, t_.bhat, t_.Bhat);
+      if (!t_.blow.empty()) difference(err_low_, t_.blow, t_.Blow);
     }
     if (project) {
       project_real(st.q);

@@ -107,7 +107,7 @@ R hairer_initial_step(F& force, const State<V>& s, const R& hmax, const ErrorSca
   const std::size_t n = s.q.size();
   V a0 = s.q, a1 = s.q;
   // A velocity-dependent force (force(q, v, a)) is evaluated at (q0, v0) and at the Euler step (q1, v1).
-  constexpr bool vd = std::is_invocable_v<F&, const V&, const V&, V&> && !std::is_invocable_v<F&, const V&, V&>;
+  constexpr bool vd = takes_velocity_v<F, V>;
   if constexpr (vd)
     force(s.q, s.v, a0);
   else

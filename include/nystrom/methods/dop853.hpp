@@ -95,20 +95,18 @@ inline RknTableau<bigcomplex> tableau() {
     for (std::size_t j = 0; j < a()[i].size(); ++j) A[i][j] = bigcomplex(big(a()[i][j]));
   RknTableau<bigcomplex> t;
   for (const auto& x : c()) t.c.push_back(bigcomplex(big(x)));
-  t.av = A;
-  t.a.assign(s, std::vector<bigcomplex>(s, zero));
-  for (std::size_t i = 0; i < s; ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      for (std::size_t k = j + 1; k < i; ++k) t.a[i][j] = t.a[i][j] + A[i][k] * A[k][j];
-  // The weights b are the 13th row of A (its last entry 0); the embedded weights b - e5.
-  std::vector<bigcomplex> b(A[s - 1]), bhat(s, zero);
-  for (std::size_t i = 0; i < s; ++i) bhat[i] = b[i] - bigcomplex(big(e5()[i]));
+  // w A: the position coefficients of a stage (row i of A^2 is A[i] A) or weights (b A) from its velocity ones.
   auto times_a = [&](const std::vector<bigcomplex>& w) {
     std::vector<bigcomplex> out(s, zero);
     for (std::size_t j = 0; j < s; ++j)
       for (std::size_t i = j + 1; i < s; ++i) out[j] = out[j] + w[i] * A[i][j];
     return out;
   };
+  t.av = A;
+  for (const auto& row : A) t.a.push_back(times_a(row));
+  // The weights b are the 13th row of A (its last entry 0); the embedded weights b - e5.
+  std::vector<bigcomplex> b(A[s - 1]), bhat(s, zero);
+  for (std::size_t i = 0; i < s; ++i) bhat[i] = b[i] - bigcomplex(big(e5()[i]));
   t.B = b;
   t.b = times_a(b);
   t.Bhat = bhat;

@@ -342,15 +342,12 @@ struct Run {
     using T = real_t<typename VE::value_type>;
     const MethodData data = method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
     if constexpr (Force::VD) {
-      // A velocity-dependent force: the main weights of the general RKN pair (the one adaptive family for it).
-      RknTableau<bigcomplex> t = std::get<RknTableau<bigcomplex>>(data);
-      t.bhat.clear();
-      t.Bhat.clear();
-      t.blow.clear();
-      t.Blow.clear();
+      // A velocity-dependent force: the general RKN pair (the one adaptive family for it), whose integrate()
+      // propagates the main weights.
       auto conv = [](const bigcomplex& x) { return to_scalar<typename VE::value_type>(x); };
-      return partial_step(RknStepper<VE, Force>(convert_tableau<typename VE::value_type>(t, conv), force(),
-                                                detail::engine_options(opt)));
+      return partial_step(
+          RknStepper<VE, Force>(convert_tableau<typename VE::value_type>(std::get<RknTableau<bigcomplex>>(data), conv),
+                                force(), detail::engine_options(opt)));
     } else {
       return partial_step(Integrator<VE, Force>(data, force(), detail::engine_options(opt)));
     }
@@ -764,22 +761,6 @@ inline void check_step_control(const MethodDef& def, const SolveOptions& opt, bo
   if (!std::isfinite(opt.h0) || opt.h0 < 0) throw invalid_input("h0 must be finite and >= 0");
 }
 
-/// The adaptive engines' options from solve()'s.
-inline AdaptiveOptions adaptive_options(const SolveOptions& opt) {
-  AdaptiveOptions ao;
-  ao.rtol = opt.rtol;
-  ao.atol = opt.atol;
-  ao.max_steps = opt.max_steps;
-  ao.h0 = opt.h0;
-  ao.h_max = opt.h_max;
-  ao.safety = opt.safety;
-  ao.fac_min = opt.fac_min;
-  ao.fac_max = opt.fac_max;
-  ao.predictive = opt.predictive;
-  ao.error_order = opt.error_order;
-  return ao;
-}
-
 /// The run of solve_impl with the method's engine, into sol.
 template <class V, class F, class VE>
 void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const SolveOptions& opt,
@@ -801,7 +782,7 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
     } else {  // a general (RKNG) pair
       long calls = 0;
       using Counted = CountingForce<typename Run<V, F, VE>::Force>;
-      auto engine = make_adaptive_integrator<VE>(def, Counted{&calls, run.force()}, adaptive_options(opt),
+      auto engine = make_adaptive_integrator<VE>(def, Counted{&calls, run.force()}, detail::adaptive_options(opt),
                                                  detail::engine_options(opt));
       run_adaptive<VE>(run, engine, calls, "adaptive-rkn", def, sol, events, resume);
     }
@@ -811,7 +792,7 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
     if (gbs) {
       run_gbs<VE>(run, def, sol, events, resume);
     } else {
-      const AdaptiveOptions ao = adaptive_options(opt);
+      const AdaptiveOptions ao = detail::adaptive_options(opt);
       long calls = 0;
       using Counted = CountingForce<typename Run<V, F, VE>::Force>;
       if (std::holds_alternative<MpeDef>(def.build())) {

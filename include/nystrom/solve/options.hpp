@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "nystrom/core/state.hpp"
+#include "nystrom/engines/options.hpp"
 
 namespace nystrom {
 
@@ -85,6 +86,22 @@ inline EngineOptions engine_options(const SolveOptions& o) {
   e.mpe_schedule = o.mpe_schedule;
   e.mpe_threads = o.mpe_threads;
   return e;
+}
+
+/// The adaptive engines' options that SolveOptions carries.
+inline AdaptiveOptions adaptive_options(const SolveOptions& opt) {
+  AdaptiveOptions ao;
+  ao.rtol = opt.rtol;
+  ao.atol = opt.atol;
+  ao.max_steps = opt.max_steps;
+  ao.h0 = opt.h0;
+  ao.h_max = opt.h_max;
+  ao.safety = opt.safety;
+  ao.fac_min = opt.fac_min;
+  ao.fac_max = opt.fac_max;
+  ao.predictive = opt.predictive;
+  ao.error_order = opt.error_order;
+  return ao;
 }
 
 }  // namespace nystrom::detail
