@@ -1,7 +1,8 @@
 // Fine's general Runge-Kutta-Nystrom (RKNG) pairs for y'' = f(t, y, y'): J. M. Fine, "Low order
 // practical Runge-Kutta-Nystrom methods", Computing 38 (1987) 281-297. RKNG4(3) (5 stages) and RKNG5(4)
 // (7 stages, first same as last: 6 forces per step). Exact rational coefficients; the orders are proved
-// by the catalog's order test on velocity-dependent forces (tests/engines/test_rkng.cpp).
+// by the order test of the general pairs on a velocity-dependent force (tests/engines/test_adaptive_rkn.cpp,
+// Rkng.*).
 #pragma once
 
 #include <string>
