@@ -260,12 +260,14 @@ std::optional<MethodDef> gbs_spec(const std::string& spec) {
 
 }  // namespace
 
-MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string& name) {
+MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string& name, bool adaptive) {
   try {
     validate_mpe_sequence(k);
   } catch (const std::invalid_argument& e) {
     throw invalid_input(e.what());
   }
+  if (adaptive && k.size() < 2)
+    throw invalid_input("an adaptive MPE needs at least two products (the error estimate drops one): '" + name + "'");
   MethodDef d;
   d.info.name = name;
   d.info.family = "mpe-midpoint";
@@ -276,9 +278,17 @@ MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string&
   d.info.forces_per_step = static_cast<int>(evals);
   d.info.velocity = true;
   d.info.source = "Gragg (1965); Hairer, Norsett & Wanner I, sec. II.9; Chin (2010) eq (14)";
-  d.info.description = "multi-product expansion over Gragg's modified midpoint rule (2k substeps), fixed step";
+  d.info.adaptive = adaptive;
+  d.info.description =
+      std::string("multi-product expansion over Gragg's modified midpoint rule (2k substeps), ") +
+      (adaptive ? "adaptive step (embedded estimate: the products without the largest k)" : "fixed step");
   d.build = [k]() -> MethodData { return MpeDef{k, "GM", {}, false}; };
   return d;
+}
+
+std::string verlet_mpe_counterpart(const MethodDef& midpoint) {
+  const std::string& name = midpoint.info.name;
+  return (midpoint.info.adaptive ? "mpe-adaptive:" : "mpe:") + name.substr(name.find(':') + 1);
 }
 
 std::vector<MethodDef> listed_methods() {
@@ -293,6 +303,7 @@ std::vector<std::string> velocity_methods() {
     if (d.info.velocity) out.push_back(d.info.name);
   out.push_back(gbs_method_def().info.name);
   out.push_back("mpe-midpoint:K1,K2,...");
+  out.push_back("mpe-midpoint-adaptive:K1,K2,...");
   return out;
 }
 
@@ -322,16 +333,18 @@ void require_first_order(const std::string& method) { require_first_order(resolv
 
 MethodDef resolve_solve_method(const std::string& spec) {
   if (auto g = gbs_spec(spec)) return *g;
-  if (detail::lower(spec).rfind("mpe-midpoint:", 0) == 0) {
+  for (const bool adaptive : {false, true}) {
+    const std::string prefix = adaptive ? "mpe-midpoint-adaptive:" : "mpe-midpoint:";
+    if (detail::lower(spec).rfind(prefix, 0) != 0) continue;
     std::vector<long> k;
     try {
-      k = parse_sequence(spec.substr(13));
+      k = parse_sequence(spec.substr(prefix.size()));
     } catch (const std::invalid_argument& e) {
       throw invalid_input(e.what());
     }
-    std::string name = "mpe-midpoint:";
+    std::string name = prefix;
     for (std::size_t i = 0; i < k.size(); ++i) name += (i ? "," : "") + std::to_string(k[i]);
-    return midpoint_mpe_method_def(k, name);
+    return midpoint_mpe_method_def(k, name, adaptive);
   }
   return resolve_method(spec);
 }

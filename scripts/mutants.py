@@ -69,6 +69,7 @@ EXCLUDED = {
 FILE_LAYER = [
     ("include/nystrom/engines/step_control.hpp", "step_control"),
     ("include/nystrom/engines/adaptive_rkn.hpp", "adaptive_rkn"),
+    ("include/nystrom/engines/embedded_pair.hpp", "adaptive_rkn"),
     ("include/nystrom/engines/adaptive_mpe", "adaptive_mpe"),
     ("include/nystrom/engines/gbs.hpp", "gbs"),
     ("include/nystrom/engines/mpe_midpoint.hpp", "velocity"),
@@ -92,7 +93,7 @@ LAYERS = {
     "rkn": ["test_engines", "test_compensated", "test_carry", "test_engine_edges", "test_adaptive_rkn"],
     "step_control": ["test_adaptive_rkn", "test_adaptive_mpe", "test_adaptive_cost", "test_carry",
                      "test_solve_directions"],
-    "adaptive_rkn": ["test_adaptive_rkn", "test_adaptive_cost", "test_carry", "test_solve_directions"],
+    "adaptive_rkn": ["test_adaptive_rkn", "test_adaptive_cost", "test_carry", "test_solve_directions", "test_velocity"],
     "adaptive_mpe": ["test_adaptive_mpe", "test_adaptive_cost", "test_carry", "test_solve_directions"],
     "gbs": ["test_gbs", "test_adaptive_cost", "test_engine_edges", "test_solve_directions"],
     "solve": ["test_solve", "test_dense", "test_solve_directions", "test_velocity"],

@@ -120,7 +120,9 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
       "weights. `GBS` runs the first-order form z = (q, v) with Gragg's modified midpoint rule as its base,\n"
       "adaptive in order and step. `mpe-midpoint:K1,K2,...` is the multi-product expansion (Chin 2010, eq 14)\n"
       "over the same rule with 2k substeps, whose error expands in even powers of the step as a symmetric base's\n"
-      "does: order 2n for n products, fixed steps, 1 + sum(2k_i - 1) force evaluations per step. First-order\n"
+      "does: order 2n for n products, fixed steps, 1 + sum(2k_i - 1) force evaluations per step.\n"
+      "`mpe-midpoint-adaptive:K1,K2,...` adds step-size control: the products without the largest k make the\n"
+      "embedded method of order 2n - 2 from the same forces (a retried step keeps its first force). First-order\n"
       "systems y' = f(t, y) run with the same methods. Every other method of the catalog is made for a(t, q) and\n"
       "is refused with one line naming these.\n";
   page +=

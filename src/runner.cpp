@@ -129,7 +129,7 @@ void check_run_request(const RunRequest& req, const MethodDef& def) {
   if (def.info.family == "mpe-midpoint")
     throw UsageError("method '" + def.info.name +
                      "' is for velocity-dependent forces (--problem arenstorf, damped-oscillator); for --problem " +
-                     req.problem + " run mpe:" + def.info.name.substr(def.info.name.find(':') + 1));
+                     req.problem + " run " + verlet_mpe_counterpart(def));
   if (req.steps_per_period <= 0) throw UsageError("--steps-per-period must be a positive integer");
   if (req.periods <= 0) throw UsageError("--periods must be a positive integer");
   if (req.steps <= 0) throw UsageError("--steps must be a positive integer");

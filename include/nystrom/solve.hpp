@@ -103,8 +103,8 @@ FirstOrderSolution<V> solve_first_order(const FirstOrderProblem<V, F>& problem, 
 }  // namespace first_order_detail
 
 /// Integrates a first-order system y' = f(t, y) (solve/first_order.hpp) with a method for velocity-dependent
-/// forces (velocity_methods(): DOP853-adaptive, Fine4-adaptive, Fine5-adaptive, GBS, mpe-midpoint:K1,K2,...); any
-/// other method is refused with one line (invalid_input).
+/// forces (velocity_methods(): DOP853-adaptive, Fine4-adaptive, Fine5-adaptive, GBS, mpe-midpoint:K1,K2,...,
+/// mpe-midpoint-adaptive:K1,K2,...); any other method is refused with one line (invalid_input).
 template <class V, class F>
 FirstOrderSolution<V> solve(const FirstOrderProblem<V, F>& problem, const MethodDef& method,
                             const SolveOptions& options = {}, const std::vector<FirstOrderEvent<V>>& events = {}) {

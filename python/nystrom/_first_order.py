@@ -62,8 +62,9 @@ def solve_ivp(fun, t_span, y0, method="GBS", t_eval=None, dense_output=False, ev
         The span; t1 < t0 integrates backward.
     y0 : array_like, 1-D
     method : str
-        ``"GBS"`` (Gragg-Bulirsch-Stoer extrapolation on Gragg's modified midpoint rule, adaptive), or
-        ``"mpe-midpoint:1,2,3"`` (the multi-product expansion of order 2n over that rule, with ``h`` or ``steps``).
+        ``"GBS"`` (Gragg-Bulirsch-Stoer extrapolation on Gragg's modified midpoint rule, adaptive), ``"DOP853"``,
+        ``"Fine5-adaptive"``, ``"mpe-midpoint-adaptive:1,2,3,4"`` (the multi-product expansion of order 2n over
+        Gragg's rule, adaptive), or ``"mpe-midpoint:1,2,3"`` (the same with ``h`` or ``steps``).
     t_eval, dense_output, rtol, atol, h, steps, max_steps, progress
         As :func:`nystrom.solve` (rtol = 1e-9 when neither tolerance is given).
     events : callable or list of callables

@@ -181,13 +181,17 @@ std::string bch_json(const std::string& method, int degree, const std::string& b
 }
 
 /// The method solve() runs: resolve_solve_method(spec); with a tolerance, a multi-product method of
-/// fixed steps becomes its adaptive form (M<2n> -> M<2n>-adaptive, mpe:K -> mpe-pv-adaptive:K).
+/// fixed steps becomes its adaptive form (M<2n> -> M<2n>-adaptive, mpe:K -> mpe-pv-adaptive:K,
+/// mpe-midpoint:K -> mpe-midpoint-adaptive:K).
 MethodDef solve_method(const std::string& spec, bool tolerance) {
   MethodDef def = resolve_solve_method(spec);
-  if (!tolerance || def.info.family != "mpe" || def.info.adaptive) return def;
+  if (!tolerance || def.info.adaptive) return def;
+  const std::string& name = def.info.name;
+  if (def.info.family == "mpe-midpoint")
+    return resolve_solve_method("mpe-midpoint-adaptive:" + name.substr(name.find(':') + 1));
+  if (def.info.family != "mpe") return def;
   const auto data = def.build();
   const auto& m = std::get<MpeDef>(data);
-  const std::string& name = def.info.name;
   const bool m_order =
       name.size() > 1 && name[0] == 'M' && name.find_first_not_of("0123456789", 1) == std::string::npos;
   if (m_order) return resolve_method(name + "-adaptive");

@@ -57,8 +57,8 @@ def test_arenstorf_closes_after_one_period():
     assert res.force_evals > 0
 
 
-@pytest.mark.parametrize("method", ["DOP853", "Fine5-adaptive"])
-def test_general_rkn_pairs_both_directions_and_on_a_first_order_system(method):
+@pytest.mark.parametrize("method", ["DOP853", "Fine5-adaptive", "mpe-midpoint-adaptive:1,2,3,4"])
+def test_adaptive_pairs_both_directions_and_on_a_first_order_system(method):
     res = nystrom.solve(damped, [1.0], [0.0], t_span=(0, 8), method=method, rtol=1e-11)
     q, v = damped_exact(1.0, 0.0, 8.0)
     assert abs(res.q[-1][0] - q) < 1e-9
@@ -76,6 +76,16 @@ def test_general_rkn_pairs_both_directions_and_on_a_first_order_system(method):
     assert abs(r.y[0, -1] - exact) < 1e-8
 
 
+def test_a_tolerance_selects_the_adaptive_midpoint_expansion():
+    res = nystrom.solve(damped, [1.0], [0.0], t_span=(0, 8), method="mpe-midpoint:1,2,3", rtol=1e-10)
+    assert res.method == "mpe-midpoint-adaptive:1,2,3" and res.h is None
+    q, v = damped_exact(1.0, 0.0, 8.0)
+    assert abs(res.q[-1][0] - q) < 1e-8 and abs(res.v[-1][0] - v) < 1e-8
+    # Without a tolerance it runs with fixed steps, and needs them.
+    fixed = nystrom.solve(damped, [1.0], [0.0], t_span=(0, 8), method="mpe-midpoint:1,2,3", steps=80)
+    assert fixed.method == "mpe-midpoint:1,2,3" and fixed.force_evals == 80 * 10
+
+
 def test_other_methods_are_refused_with_the_libraries_line():
     for method, kw in (("M8", dict(steps=100)), ("DP12-adaptive", dict(rtol=1e-8))):
         name = nystrom.method_info(method)["name"]
@@ -83,7 +93,7 @@ def test_other_methods_are_refused_with_the_libraries_line():
             nystrom.solve(arenstorf, Q0, V0, t_span=(0, 1), method=method, **kw)
         assert str(e.value) == (f"method '{name}' does not support velocity-dependent forces a(t, q, v); "
                                 "methods that do: DOP853-adaptive, Fine4-adaptive, Fine5-adaptive, GBS, "
-                                "mpe-midpoint:K1,K2,...")
+                                "mpe-midpoint:K1,K2,..., mpe-midpoint-adaptive:K1,K2,...")
 
 
 def test_solve_ivp_dense_output_and_events():
@@ -124,5 +134,5 @@ def test_solve_ivp_van_der_pol_period():
 def test_solve_ivp_refuses_other_methods():
     with pytest.raises(ValueError, match="^method 'M8' does not integrate first-order systems y' = f\\(t, y\\); "
                                          "methods that do: DOP853-adaptive, Fine4-adaptive, Fine5-adaptive, "
-                                         "GBS, mpe-midpoint:K1,K2,...$"):
+                                         "GBS, mpe-midpoint:K1,K2,..., mpe-midpoint-adaptive:K1,K2,...$"):
         nystrom.solve_ivp(lambda t, y: -y, (0, 1), [1.0], method="M8")

@@ -1,5 +1,6 @@
 // Velocity-dependent forces a(t, q, v) through solve(): GBS on the first-order form (Gragg's modified
-// midpoint) and the general RKN pairs (DOP853 in Nystrom form, Fine's 4(3) and 5(4)) against exact solutions (positions
+// midpoint), the multi-product expansion over that rule (fixed and adaptive) and the general RKN pairs (DOP853 in
+// Nystrom form, Fine's 4(3) and 5(4)) against exact solutions (positions
 // and velocities, both time directions), the Arenstorf orbit of Hairer-Nørsett-Wanner I, the compiled path against the
 // inline one, dense output and events, the cost the controller decides, and the one-line refusal of every method that
 // is not made for such forces.
@@ -11,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "nystrom/engines/adaptive_mpe_coefficients.hpp"
+#include "nystrom/engines/mpe_midpoint.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/methods/method_data.hpp"
 #include "nystrom/problems/arenstorf.hpp"
@@ -42,8 +45,10 @@ double arenstorf_return_error(const std::string& method, double tol, long* evals
   return std::hypot(sol.q_final[0] - Arenstorf<double>::q0x(), sol.q_final[1]);
 }
 
-// The adaptive methods for y'' = f(t, y, y'): extrapolation, and the general RKN pairs.
-const char* const kVelocityPairs[] = {"GBS", "DOP853-adaptive", "Fine5-adaptive", "Fine4-adaptive"};
+// The adaptive methods for y'' = f(t, y, y'): extrapolation, the general RKN pairs and the multi-product expansion
+// of order 8 over the midpoint rule.
+const char* const kVelocityPairs[] = {"GBS", "DOP853-adaptive", "Fine5-adaptive", "Fine4-adaptive",
+                                      "mpe-midpoint-adaptive:1,2,3,4"};
 
 }  // namespace
 
@@ -196,7 +201,8 @@ TEST(Velocity, MethodsNotForVelocityForcesAreRefusedWithOneLine) {
   const SecondOrderProblem prob(osc, Vd{1.0}, Vd{0.0}, 0.0, 1.0);
   const std::string expected =
       "method 'M8' does not support velocity-dependent forces a(t, q, v); methods that do: DOP853-adaptive, "
-      "Fine4-adaptive, Fine5-adaptive, GBS, mpe-midpoint:K1,K2,...";
+      "Fine4-adaptive, Fine5-adaptive, GBS, mpe-midpoint:K1,K2,..., "
+      "mpe-midpoint-adaptive:K1,K2,...";
   EXPECT_EQ(velocity_refusal("M8"), expected);
   for (const char* m : {"M8", "VV", "DP12-adaptive", "M10-adaptive"}) {
     try {
@@ -215,8 +221,9 @@ TEST(Velocity, MethodsNotForVelocityForcesAreRefusedWithOneLine) {
     EXPECT_EQ(d.info.velocity, t != nullptr && t->general()) << d.info.name;
   }
   EXPECT_TRUE(gbs_method_def().info.velocity);
-  EXPECT_EQ(velocity_methods(), (std::vector<std::string>{"DOP853-adaptive", "Fine4-adaptive", "Fine5-adaptive", "GBS",
-                                                          "mpe-midpoint:K1,K2,..."}));
+  EXPECT_EQ(velocity_methods(),
+            (std::vector<std::string>{"DOP853-adaptive", "Fine4-adaptive", "Fine5-adaptive", "GBS",
+                                      "mpe-midpoint:K1,K2,...", "mpe-midpoint-adaptive:K1,K2,..."}));
 }
 
 TEST(Velocity, TheForcesBoundsAreChecked) {
@@ -280,7 +287,8 @@ TEST(FirstOrder, OtherMethodsAreRefusedWithOneLine) {
   } catch (const invalid_input& e) {
     EXPECT_EQ(std::string(e.what()),
               "method 'M8' does not integrate first-order systems y' = f(t, y); methods that do: DOP853-adaptive, "
-              "Fine4-adaptive, Fine5-adaptive, GBS, mpe-midpoint:K1,K2,...");
+              "Fine4-adaptive, Fine5-adaptive, GBS, mpe-midpoint:K1,K2,..., "
+              "mpe-midpoint-adaptive:K1,K2,...");
   }
 }
 
@@ -347,6 +355,65 @@ TEST(MidpointMpe, FirstOrderSystemAndRefusalForAccelerations) {
   }
 }
 
+TEST(MidpointMpe, AdaptiveErrorEstimateHasOrderTwoNMinusOne) {
+  // The estimate sum_i d_i (T_i - z0) of the products without the largest k is the local error of the method of
+  // order 2n - 2: it shrinks like h^(2n - 1) (5 for 1,2,3, 7 for 1,2,3,4); the step itself is that of the fixed
+  // method (bitwise).
+  auto force = [](const Vd& q, const Vd& v, Vd& a) { a[0] = -std::sin(q[0]) - 0.3 * v[0] - 0.2 * v[0] * v[0] * v[0]; };
+  for (const std::vector<long>& k : {std::vector<long>{1, 2, 3}, std::vector<long>{1, 2, 3, 4}}) {
+    const AdaptiveMpeCoefficients ac = adaptive_mpe_coefficients(k);
+    const auto c = mpe_coefficients_as<double>(ac.high), d = mpe_coefficients_as<double>(ac.error());
+    double e[2];
+    for (int j = 0; j < 2; ++j) {
+      const double h = 0.2 / (1 << j);
+      MidpointMpeIntegrator<Vd, decltype(force)> stepper(k, c, force, {}, d);
+      State<Vd> s{Vd{1.2}, Vd{0.3}}, err;
+      stepper.step_with_error(s, h, err);
+      e[j] = std::hypot(err.q[0], err.v[0]);
+      MidpointMpeIntegrator<Vd, decltype(force)> fixed(k, c, force);
+      State<Vd> f{Vd{1.2}, Vd{0.3}};
+      fixed.integrate(f, h, 1);
+      EXPECT_EQ(f.q, s.q);
+      EXPECT_EQ(f.v, s.v);
+    }
+    const double p = std::log2(e[0] / e[1]), expected = 2.0 * static_cast<double>(k.size()) - 1;
+    EXPECT_NEAR(p, expected, 0.4) << k.size() << " products: " << e[0] << " " << e[1];
+  }
+}
+
+TEST(MidpointMpe, AdaptiveCostIsExactAndItsOrderIsInTheCatalog) {
+  // Two forces for the starting step, 1 + sum (2 k_i - 1) per attempt from a new state and sum (2 k_i - 1) for a
+  // retry after a rejection (the start force is kept): 16 + 1 per accepted step for 1,2,3,4.
+  const MethodDef def = resolve_solve_method("mpe-midpoint-adaptive:1,2,3,4");
+  EXPECT_EQ(def.info.order, 8);
+  EXPECT_TRUE(def.info.adaptive);
+  EXPECT_TRUE(def.info.velocity);
+  EXPECT_EQ(def.info.forces_per_step, 17);
+  long total_rejected = 0;
+  for (double tol : {1e-7, 1e-10, 1e-13}) {
+    const SecondOrderProblem prob(ArenstorfForce{}, Vd{Arenstorf<double>::q0x(), 0.0},
+                                  Vd{0.0, Arenstorf<double>::v0y()}, 0.0, Arenstorf<double>::period());
+    const auto sol = solve(prob, def, {.rtol = tol});
+    EXPECT_EQ(sol.force_evals, 2 + 16 * (sol.accepted + sol.rejected) + sol.accepted) << tol;
+    total_rejected += sol.rejected;
+  }
+  EXPECT_GT(total_rejected, 0);  // the retry's saving was exercised
+  // A single product has no estimate; a step count alone is refused; a force a(q) is sent to the adaptive MPE
+  // over Verlet.
+  EXPECT_THROW(resolve_solve_method("mpe-midpoint-adaptive:4"), invalid_input);
+  const SecondOrderProblem pd(osc, Vd{1.0}, Vd{0.0}, 0.0, 1.0);
+  EXPECT_THROW(solve(pd, def, {.steps = 10}), invalid_input);
+  auto harmonic = [](const Vd& q, Vd& acc) { acc[0] = -q[0]; };
+  try {
+    solve(SecondOrderProblem(harmonic, Vd{1.0}, Vd{0.0}, 0.0, 1.0), "mpe-midpoint-adaptive:1,2,3", {.rtol = 1e-8});
+    ADD_FAILURE() << "not refused";
+  } catch (const invalid_input& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "method 'mpe-midpoint-adaptive:1,2,3' is for velocity-dependent forces and first-order systems; for "
+              "a(t, q) run its multi-product expansion over Verlet, mpe-adaptive:1,2,3");
+  }
+}
+
 // ---- the general RKN pairs ----------------------------------------------------------------------------------
 
 TEST(Velocity, GeneralPairsCostOnArenstorfFollowsTheirOrder) {
@@ -382,10 +449,10 @@ TEST(Velocity, GeneralPairsRefuseWhatTheyCannotDo) {
   EXPECT_THROW(solve(pd, "DOP853-adaptive", {.steps = 10}), invalid_input);
 }
 
-TEST(Velocity, GeneralPairsRestartFromACheckpointBitwise) {
+TEST(Velocity, AdaptivePairsRestartFromACheckpointBitwise) {
   // A time- and velocity-dependent force, forward and backward: the run resumed from the checkpoint's text ends
   // bitwise where the uninterrupted one does (one force more at most: the reused first force is not in the text).
-  for (const char* m : {"DOP853-adaptive", "Fine5-adaptive"})
+  for (const char* m : {"DOP853-adaptive", "Fine5-adaptive", "mpe-midpoint-adaptive:1,2,3"})
     for (const double t1 : {9.0, -9.0}) {
       SCOPED_TRACE(std::string(m) + (t1 > 0 ? " forward" : " backward"));
       const SecondOrderProblem prob(osc, Vd{1.0}, Vd{-0.4}, 0.0, t1);
@@ -398,7 +465,7 @@ TEST(Velocity, GeneralPairsRestartFromACheckpointBitwise) {
       const auto first = solve(prob, m, opt);
       ASSERT_TRUE(first.checkpoint.has_value());
       EXPECT_EQ(first.q_final, plain.q_final);
-      const auto second = resume(prob, resolve_method(m), checkpoint_from_text<double>(text), opt);
+      const auto second = resume(prob, resolve_solve_method(m), checkpoint_from_text<double>(text), opt);
       EXPECT_EQ(second.q_final, plain.q_final);
       EXPECT_EQ(second.v_final, plain.v_final);
       EXPECT_EQ(second.accepted, plain.accepted);

@@ -33,8 +33,9 @@ TEST(CliVelocity, ArenstorfReturnErrorFollowsTheTolerance) {
 }
 
 TEST(CliVelocity, GeneralRknPairsRunTheArenstorfContract) {
-  // Any method for velocity-dependent forces can be named: DOP853 (by its alias) and Fine's pairs.
-  for (const char* m : {"DOP853", "Fine5-adaptive", "Fine4-adaptive"}) {
+  // Any method for velocity-dependent forces can be named: DOP853 (by its alias), Fine's pairs and the adaptive
+  // multi-product expansion over the midpoint rule.
+  for (const char* m : {"DOP853", "Fine5-adaptive", "Fine4-adaptive", "mpe-midpoint-adaptive:1,2,3,4"}) {
     const auto r = run(std::string("run --problem arenstorf --method ") + m + " --tol 1e-10 --periods 1 --json");
     ASSERT_EQ(r.code, 0) << m << r.err;
     const auto j = nlohmann::json::parse(r.out);
@@ -69,7 +70,7 @@ TEST(CliVelocity, MethodsForAccelerationsOnlyAreRefusedWithOneLine) {
     EXPECT_NE(
         r.err.find(
             "does not support velocity-dependent forces a(t, q, v); methods that do: DOP853-adaptive, Fine4-adaptive, "
-            "Fine5-adaptive, GBS, mpe-midpoint:K1,K2,...\n"),
+            "Fine5-adaptive, GBS, mpe-midpoint:K1,K2,..., mpe-midpoint-adaptive:K1,K2,...\n"),
         std::string::npos)
         << r.err;
     EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;  // one line

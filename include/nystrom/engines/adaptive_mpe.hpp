@@ -46,7 +46,7 @@
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/adaptive_mpe_coefficients.hpp"
 #include "nystrom/engines/adaptive_mpe_kernels.hpp"
-#include "nystrom/engines/integrator.hpp"  // mpe_coefficients_as, method_data_for
+#include "nystrom/engines/integrator.hpp"  // mpe_coefficients_as, shared_method_data_for
 #include "nystrom/engines/splitting.hpp"
 #include "nystrom/engines/step_control.hpp"
 #include "nystrom/methods/method.hpp"
@@ -597,8 +597,8 @@ AdaptiveMpeIntegrator<V, F> make_adaptive_mpe_integrator(const MethodDef& def, F
                                                          EngineOptions eopt = {}) {
   using S = typename V::value_type;
   opt.validate();
-  const MethodData data = method_data_for(def, scalar_traits<S>::bits(), scalar_traits<S>::name());
-  const auto* m = std::get_if<MpeDef>(&data);
+  const auto data = shared_method_data_for(def, scalar_traits<S>::bits(), scalar_traits<S>::name());
+  const auto* m = std::get_if<MpeDef>(data.get());
   if (!m) throw std::invalid_argument("method '" + def.info.name + "' is not a multi-product method");
   const AdaptiveMpeCoefficients ac = adaptive_mpe_coefficients(m->k);
   auto conv = [](const bigcomplex& x) { return to_scalar<S>(x); };

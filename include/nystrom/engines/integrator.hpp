@@ -98,10 +98,10 @@ Integrator<V, F> make_integrator(const MethodDef& def, F force, EngineOptions op
     throw invalid_input("method '" + def.info.name +
                         "' chooses its steps from a tolerance: run it with solve() (nystrom/solve.hpp), not with "
                         "fixed steps");
-  const MethodData data = method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
+  const auto data = shared_method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
   // The working values are created outside method_data_for's reference precision: for
   // run-time-precision types (mpfr_real) it must not leak into the working precision.
-  return Integrator<V, F>(data, std::move(force), opt);
+  return Integrator<V, F>(*data, std::move(force), opt);
 }
 
 /// Any fixed-step method on a real state: a real method steps it directly; a complex-coefficient method

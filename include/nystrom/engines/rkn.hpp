@@ -255,7 +255,7 @@ class RknStepper {
   V sq_{}, sv_{};  // its start (its force is f_[s-1])
   V dq_{}, dv_{};
   Compensator<V> comp_;
-  State<V> err_low_;
+  State<V> err_low_{};
   bool cache_valid_ = false;
   long evals_ = 0;
 };

@@ -49,9 +49,15 @@ MethodDef resolve_method(const std::string& spec);
 MethodDef gbs_method_def(const GbsDef& gbs = {});
 
 /// The multi-product expansion over Gragg's modified midpoint rule with sequence k (engines/mpe_midpoint.hpp):
-/// fixed steps, order 2 k.size(), for velocity-dependent forces and first-order systems ("mpe-midpoint:1,2,3";
-/// family "mpe-midpoint"; resolved by resolve_solve_method only, since it runs through solve()).
-MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string& name);
+/// order 2 k.size(), for velocity-dependent forces and first-order systems, with fixed steps
+/// ("mpe-midpoint:1,2,3") or adaptive ("mpe-midpoint-adaptive:1,2,3,4", at least two products; the error
+/// estimate drops the largest k); family "mpe-midpoint", resolved by resolve_solve_method only, since it runs
+/// through solve().
+MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string& name, bool adaptive = false);
+
+/// The multi-product expansion over Verlet with the sequence of a midpoint one, for forces a(t, q):
+/// "mpe:1,2,3" for "mpe-midpoint:1,2,3", "mpe-adaptive:1,2,3" for "mpe-midpoint-adaptive:1,2,3".
+std::string verlet_mpe_counterpart(const MethodDef& midpoint);
 
 /// The names of the methods that integrate velocity-dependent forces a(t, q, v) (MethodInfo::velocity):
 /// those of the catalog and GBS.
@@ -71,7 +77,7 @@ void require_first_order(const std::string& method);
 
 /// What solve() resolves: resolve_method(spec), "GBS", "GBS:SEQUENCE" or "GBS:SEQUENCE:COLUMNS" for the
 /// extrapolation integrator (sequence harmonic, romberg or bulirsch; columns 3 to 20, default harmonic:12), and
-/// "mpe-midpoint:K1,K2,..." (midpoint_mpe_method_def).
+/// "mpe-midpoint:K1,K2,..." and "mpe-midpoint-adaptive:K1,K2,..." (midpoint_mpe_method_def).
 MethodDef resolve_solve_method(const std::string& spec);
 
 /// Reads the method file of a "file:PATH" specification. The method-file format, which verifies a file's

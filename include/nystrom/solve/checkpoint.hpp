@@ -40,7 +40,7 @@ struct Checkpoint {
   static constexpr int format_version = 2;
   std::string method;             // the method specification it was taken with
   std::string problem;            // the caller's description of the problem (refused when it differs)
-  std::string engine;             // "fixed", "adaptive-rkn", "adaptive-mpe", "gbs"
+  std::string engine;             // "fixed", "adaptive-rkn", "adaptive-mpe", "adaptive-mpe-midpoint", "gbs"
   T t{};                          // the time of the step boundary
   long step_index = 0;            // fixed step: steps done
   std::vector<T> state;           // the engine's q then v (complex: real and imaginary parts), flattened
@@ -170,7 +170,7 @@ void validate_checkpoint(const Checkpoint<T>& c) {
   using checkpoint_detail::malformed;
   auto finite = [](const T& x) { return std::isfinite(static_cast<long double>(x)); };
   const bool fixed = c.engine == "fixed", gbs = c.engine == "gbs";
-  const bool adaptive = c.engine == "adaptive-rkn" || c.engine == "adaptive-mpe";
+  const bool adaptive = c.engine == "adaptive-rkn" || c.engine == "adaptive-mpe" || c.engine == "adaptive-mpe-midpoint";
   if (!fixed && !gbs && !adaptive) throw malformed("unknown engine '" + c.engine.substr(0, 40) + "'");
   if (c.method.empty()) throw malformed("no method");
   if (c.state.empty() || c.state.size() % 2 != 0) throw malformed("the state must hold q and v (an even length)");

@@ -340,10 +340,14 @@ struct Run {
   /// the whole multi-product expansion of an adaptive one), for the partial steps.
   typename DenseOutput<V>::PartialStep propagated_method(const MethodDef& def) const {
     using T = real_t<typename VE::value_type>;
-    const MethodData data = method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
+    const auto shared = shared_method_data_for(def, scalar_traits<T>::bits(), scalar_traits<T>::name());
+    const MethodData& data = *shared;
     if constexpr (Force::VD) {
-      // A velocity-dependent force: the general RKN pair (the one adaptive family for it), whose integrate()
-      // propagates the main weights.
+      // A velocity-dependent force: the multi-product expansion over the midpoint rule of an adaptive one, or
+      // the general RKN pair, whose integrate() propagates the main weights.
+      if (const auto* m = std::get_if<MpeDef>(&data))
+        return partial_step(MidpointMpeIntegrator<VE, Force>(m->k, mpe_coefficients_as<T>(mpe_coefficients(m->k)),
+                                                             force(), detail::engine_options(opt)));
       auto conv = [](const bigcomplex& x) { return to_scalar<typename VE::value_type>(x); };
       return partial_step(
           RknStepper<VE, Force>(convert_tableau<typename VE::value_type>(std::get<RknTableau<bigcomplex>>(data), conv),
@@ -770,18 +774,26 @@ void run_method(SecondOrderProblem<V, F>& prob, const MethodDef& def, const Solv
   constexpr bool td = SecondOrderProblem<V, F>::time_dependent;
   if constexpr (SecondOrderProblem<V, F>::velocity_dependent) {
     // Only the methods for y'' = f(t, y, y') are instantiated (solve_impl refused the others).
-    if (def.info.family == "mpe-midpoint") {
+    const bool midpoint = def.info.family == "mpe-midpoint";
+    if (midpoint && !def.info.adaptive) {
       run_fixed<VE>(prob, def, opt, events, sol, dir, resume);
       return;
     }
     if (!gbs && !def.info.adaptive) throw invalid_input(velocity_refusal(def.info.name));
     check_tolerances(def, opt);
     Run<V, F, VE> run{prob, opt, dir, prob.q0.size(), def.info.name};
+    long calls = 0;
+    using Counted = CountingForce<typename Run<V, F, VE>::Force>;
     if (gbs) {
       run_gbs<VE>(run, def, sol, events, resume);
+    } else if (midpoint) {  // the adaptive multi-product expansion over the midpoint rule
+      using T = real_t<typename VE::value_type>;
+      const AdaptiveMpeCoefficients ac = adaptive_mpe_coefficients(std::get<MpeDef>(def.build()).k);
+      AdaptiveMidpointMpeIntegrator<VE, Counted> engine(
+          ac.high.k, mpe_coefficients_as<T>(ac.high), mpe_coefficients_as<T>(ac.error()), Counted{&calls, run.force()},
+          detail::adaptive_options(opt), detail::engine_options(opt));
+      run_adaptive<VE>(run, engine, calls, "adaptive-mpe-midpoint", def, sol, events, resume);
     } else {  // a general (RKNG) pair
-      long calls = 0;
-      using Counted = CountingForce<typename Run<V, F, VE>::Force>;
       auto engine = make_adaptive_integrator<VE>(def, Counted{&calls, run.force()}, detail::adaptive_options(opt),
                                                  detail::engine_options(opt));
       run_adaptive<VE>(run, engine, calls, "adaptive-rkn", def, sol, events, resume);
@@ -834,8 +846,8 @@ Solution<V> solve_impl(const SecondOrderProblem<V, F>& problem, const MethodDef&
     if (def.info.family == "mpe-midpoint")
       throw invalid_input("method '" + def.info.name +
                           "' is for velocity-dependent forces and first-order systems; for a(t, q) run its "
-                          "multi-product expansion over Verlet, mpe:" +
-                          def.info.name.substr(def.info.name.find(':') + 1));
+                          "multi-product expansion over Verlet, " +
+                          verlet_mpe_counterpart(def));
   }
   if (opt.max_steps <= 0) throw invalid_input("max_steps must be positive");
   P prob = problem;
