@@ -261,6 +261,15 @@ TEST(AdaptiveRkn, TableauOrderIsCappedAtFourteenUnlessAskedForMore) {
   EXPECT_EQ(tableau_order(t), 14);
   EXPECT_EQ(tableau_order(t, 15), 15);
   EXPECT_EQ(tableau_order(t, 10), 10);
+  // The orders are kept per tableau (evaluated once per process): a weight changed by 1e-9 is another tableau,
+  // of order 0 (sum B = 1 fails) or 1 (sum b = 1/2 fails), and the original keeps its order.
+  RknTableau<double> u = t;
+  u.B[5] += 1e-9;
+  EXPECT_EQ(tableau_order(u), 0);
+  u.B[5] = t.B[5];
+  u.b[7] += 1e-9;
+  EXPECT_EQ(tableau_order(u), 1);
+  EXPECT_EQ(tableau_order(t), 14);
 }
 
 // ---- general (RKNG) pairs for y'' = f(t, y, y'): Fine's 4(3) and 5(4), DOP853 in Nystrom form ----------

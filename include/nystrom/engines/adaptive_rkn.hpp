@@ -40,11 +40,14 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <variant>
+#include <vector>
 
 #include "nystrom/core/bignum.hpp"
 #include "nystrom/core/error.hpp"
@@ -62,10 +65,25 @@ namespace nystrom {
 /// The order of the main weights of a real tableau, from its order conditions evaluated in double (a
 /// condition counts as satisfied below 1e-10; far above rounding, far below a failing condition of
 /// a practical method). embedded_order: the same for the embedded weights.
+/// Evaluated once per tableau and process: the conditions up to order 14 took 0.3 ms per integrator for DP12, a
+/// fifth of a 100-period Kepler run at tolerance 1e-12.
 template <class S>
 int tableau_order(const RknTableau<S>& t, int max_order = 14) {
   auto d = convert_tableau<double>(t, [](const S& x) { return as_double(x); });
-  return rkn_order(d, 1e-10, max_order);
+  std::vector<double> key{static_cast<double>(max_order), static_cast<double>(d.c.size())};
+  for (const auto& row : d.a) key.insert(key.end(), row.begin(), row.end());
+  for (const auto* w : {&d.c, &d.b, &d.B}) key.insert(key.end(), w->begin(), w->end());
+  static std::mutex mutex;
+  static std::map<std::vector<double>, int> known;  // at most 256 tableaux
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (const auto it = known.find(key); it != known.end()) return it->second;
+  }
+  const int order = rkn_order(d, 1e-10, max_order);
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (known.size() >= 256) known.clear();
+  known.emplace(std::move(key), order);
+  return order;
 }
 template <class S>
 int embedded_order(const RknTableau<S>& t, int max_order = 14) {

@@ -9,20 +9,25 @@
 // First-same-as-last is detected from the tableau (stage 1 at q_n, last stage at q_{n+1}): the last
 // stage is evaluated at the step's result itself, and the reused force is checked against the state it
 // was evaluated at.
-// An optional embedded solution (bhat, Bhat) gives an error estimate for step control.
+// An optional embedded solution (bhat, Bhat) gives an error estimate for step control. The compensated steps of
+// step control (step_with_error with carries) keep their rounding below the force's in double and float
+// (precise_update).
 //
 // A general (RKNG) tableau (RknTableau::general()) also integrates a velocity-dependent force,
 // force(q, v, a): the stages are evaluated at (y_i, w_i) with w_i = v_n + h sum_{j<i} av_ij f_j
 // (Hairer, Norsett & Wanner I, sec. II.14). A tableau without velocity coefficients refuses such a force.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "nystrom/core/eft.hpp"
 #include "nystrom/core/state.hpp"
 #include "nystrom/methods/rkn_tableau.hpp"
 
@@ -37,6 +42,9 @@ class RknStepper {
 
   /// Whether the force takes the velocity (force(q, v, a)).
   static constexpr bool velocity_dependent = takes_velocity_v<Force, V>;
+  /// Whether a compensated step with an error estimate is made in double-word arithmetic (precise_update).
+  static constexpr bool precise_capable =
+      (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>)&&!velocity_dependent;
 
   RknStepper(RknTableau<scalar_type> t, Force force, EngineOptions opt = {})
       : t_(std::move(t)), force_(std::move(force)), opt_(opt) {
@@ -54,6 +62,10 @@ class RknStepper {
         if (velocity_dependent && !(t_.av[i][j] == scalar_type(0))) nzv_.push_back({i, j, t_.av[i][j]});
       }
     f_.resize(s);
+    if constexpr (precise_capable) {
+      // The update in difference form needs sum b = 1/2 and sum B = 1 (every method of order 2 or more).
+      precise_ = weight_sum_is(t_.b, scalar_type(0.5)) && weight_sum_is(t_.B, scalar_type(1));
+    }
   }
 
   const RknTableau<scalar_type>& tableau() const { return t_; }
@@ -111,6 +123,7 @@ class RknStepper {
     constexpr bool local = is_std_array<V>::value;
     std::conditional_t<local, V, V&> y = y_, dq = dq_, dv = dv_;
     const bool project = is_complex_v<scalar_type> && !opt_.keep_complex;
+    const bool precise = precise_capable && precise_ && comp && err;
     std::size_t k = 0, kv = 0;  // indices into nz_ and nzv_, ordered by stage
     if constexpr (velocity_dependent) resize_like(w_, st.v);
     // First same as last: the last stage is the step's result (q_{n+1}, and v_{n+1} for a velocity-dependent
@@ -134,9 +147,14 @@ class RknStepper {
           continue;  // f_[0] already holds the force at (q_n, v_n)
         }
       }
-      assign(y, st.q);
+      // The stage position; in a precise step its increment first, with the position's carry, then q (not the
+      // first stage: its force is the one first-same-as-last evaluates at q itself, also after a restart).
+      const bool carried = precise && i > 0;
+      assign(y, carried ? comp->cq : st.q);
       if (!(t_.c[i] == scalar_type(0))) axpy(y, t_.c[i] * h, st.v);
       for (; k < nz_.size() && nz_[k].i == i; ++k) axpy(y, nz_[k].a * h2, f_[nz_[k].j]);
+      if (carried)
+        for (std::size_t j = 0; j < y.size(); ++j) y[j] += st.q[j];
       if constexpr (velocity_dependent) {
         assign(w_, st.v);
         for (; kv < nzv_.size() && nzv_[kv].i == i; ++kv) axpy(w_, nzv_[kv].a * h, f_[nzv_[kv].j]);
@@ -165,7 +183,16 @@ class RknStepper {
       ++evals_;
     };
     const bool v_first = at_end && velocity_dependent;
-    if (comp) {
+    bool updated = false;
+    if constexpr (precise_capable) {
+      if (precise) {
+        precise_update(st, *comp, h, h2, ns, at_end, last_stage);
+        updated = true;
+      }
+    }
+    if (updated) {
+      // done
+    } else if (comp) {
       // One increment per step for q and for v, added with compensation.
       resize_like(dq, st.q);
       resize_like(dv, st.q);
@@ -237,6 +264,61 @@ class RknStepper {
     }
   }
 
+  // The update of a compensated step with an error estimate, its rounding kept below the force's (Kepler over 100
+  // periods in double, DP12-adaptive at tolerances 1.8e-14..2.5e-15: the position error's rms falls from 2.5e-12
+  // to 4.3e-13 at e = 0.5 and from 3.0e-12 to 9.6e-13 at e = 0.9, where the same steps in long double score
+  // 3.5e-13 and 6.8e-13: what remains is truncation). The weighted sums in difference form,
+  //   sum_i B_i f_i = f_1 + sum_{i>1} B_i (f_i - f_1),   sum_i b_i f_i = f_1 / 2 + sum_{i>1} b_i (f_i - f_1),
+  // so that the weights' rounding touches only the small differences and sum b = 1/2, sum B = 1 hold exactly
+  // (rounded weights bias every step the same way); the large terms h v, h^2 f_1 / 2 and h f_1 as exact
+  // products; q and v with their carries as double-word sums (two-sums, then the low parts), the velocity's
+  // carry entering the position's increment. The stage positions carry the position's carry (stage loop).
+  template <class LastStage>
+  NYSTROM_ALWAYS_INLINE void precise_update(State<V>& st, Compensator<V>& c, scalar_type h, scalar_type h2,
+                                            std::size_t ns, bool at_end, LastStage& last_stage) {
+    using eft::two_prod;
+    using eft::two_sum;
+    const std::size_t s = t_.stages(), n = st.q.size();
+    scalar_type h2e;
+    two_prod(h, h, h2e);
+    const scalar_type hh = scalar_type(0.5) * h2, hhe = scalar_type(0.5) * h2e;
+    for (std::size_t j = 0; j < n; ++j) {
+      const scalar_type f1 = f_[0][j];
+      scalar_type sb = 0;
+      for (std::size_t i = 1; i < ns; ++i) sb += t_.b[i] * (f_[i][j] - f1);
+      scalar_type e1, e2, e3, e4;
+      const scalar_type p1 = two_prod(h, st.v[j], e1);
+      const scalar_type p2 = two_prod(hh, f1, e2);
+      const scalar_type s1 = two_sum(st.q[j], p1, e3);
+      const scalar_type s2 = two_sum(s1, p2, e4);
+      const scalar_type low = (e3 + e4) + (c.cq[j] + (e1 + e2)) + (hhe * f1 + h * c.cv[j] + h2 * sb);
+      st.q[j] = two_sum(s2, low, c.cq[j]);
+    }
+    if (at_end) last_stage();
+    for (std::size_t j = 0; j < n; ++j) {
+      const scalar_type f1 = f_[0][j];
+      scalar_type sB = 0;
+      for (std::size_t i = 1; i < s; ++i) sB += t_.B[i] * (f_[i][j] - f1);
+      scalar_type e1, e2;
+      const scalar_type p = two_prod(h, f1, e1);
+      const scalar_type s1 = two_sum(st.v[j], p, e2);
+      const scalar_type low = e2 + (c.cv[j] + e1) + h * sB;
+      st.v[j] = two_sum(s1, low, c.cv[j]);
+    }
+  }
+
+  // Whether the weights sum to target up to their rounding (an error-free sum).
+  static bool weight_sum_is(const std::vector<scalar_type>& w, scalar_type target) {
+    scalar_type hi = 0, lo = 0;
+    for (const auto& x : w) {
+      scalar_type e;
+      hi = eft::two_sum(hi, x, e);
+      lo += e;
+    }
+    using std::abs;
+    return abs((target - hi) - lo) <= scalar_type(64) * std::numeric_limits<scalar_type>::epsilon();
+  }
+
   static bool same(const V& x, const V& y) {
     if (x.size() != y.size()) return false;
     for (std::size_t i = 0; i < x.size(); ++i)
@@ -257,6 +339,7 @@ class RknStepper {
   Compensator<V> comp_;
   State<V> err_low_{};
   bool cache_valid_ = false;
+  bool precise_ = false;  // the weights allow precise_update
   long evals_ = 0;
 };
 
