@@ -19,7 +19,9 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <thread>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -395,11 +397,29 @@ TEST(QuantumCli, ConvergeStopsImaginaryTimeEarly) {
 namespace {
 
 /// Two ranks on this machine, also as root and in a container (no remote launcher, no shared-memory single
-/// copy). OpenMPI keeps allocations of MPI_Init until exit, which LeakSanitizer would report as leaks.
+/// copy). OpenMPI keeps allocations of MPI_Init until exit, which LeakSanitizer would report as leaks. Each launch
+/// keeps its own session directory: two launches starting at once (ctest -j) otherwise race to
+/// create the same /tmp/ompi.HOST.UID and one fails in orte_init.
 std::string two_ranks() {
+  // (short: OpenMPI's sockets live below it, and a socket's path is limited to 107 characters)
+  struct Sessions {  // removed when the test program ends
+    std::vector<std::filesystem::path> dirs;
+    ~Sessions() {
+      for (const auto& d : dirs) {
+        std::error_code ec;
+        std::filesystem::remove_all(d, ec);
+      }
+    }
+  };
+  static Sessions sessions;
+  const auto session = std::filesystem::temp_directory_path() /
+                       ("nyompi-" + std::to_string(::getpid()) + "-" + std::to_string(sessions.dirs.size() + 1));
+  std::filesystem::create_directories(session);
+  sessions.dirs.push_back(session);
   return "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_plm=isolated "
          "OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_btl_vader_single_copy_mechanism=none "
-         "ASAN_OPTIONS=detect_leaks=0 " NYSTROM_MPIEXEC " --oversubscribe -np 2";
+         "OMPI_MCA_orte_tmpdir_base=" +
+         session.string() + " ASAN_OPTIONS=detect_leaks=0 " NYSTROM_MPIEXEC " --oversubscribe -np 2";
 }
 
 void expect_same_result(const std::string& args) {
