@@ -8,10 +8,12 @@
 // DP12-adaptive's round-off at the tightest tolerances stays below its truncation error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <complex>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -20,6 +22,8 @@
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/nystrom.hpp"
 #include "nystrom/problems/reference.hpp"
+#include "nystrom/solve/checkpoint.hpp"
+#include "nystrom/solve_inline.hpp"
 
 using namespace nystrom;
 
@@ -172,10 +176,10 @@ TEST(Compensated, ErrorFreeSumAndProductAreExact) {
 
 namespace {
 
-// rms over tolerances 10^-13.75 .. 10^-14.5 of DP12-adaptive's final position error on Kepler (100 periods),
-// against the exact orbit of the run's own initial state.
-template <class T>
-double adaptive_floor_rms(double ecc, long* steps = nullptr) {
+// rms over tolerances 10^log_tol0 .. 10^(log_tol0 - 0.75) of DP12-adaptive's final position error on Kepler (100
+// periods), against the exact orbit of the run's own initial state.
+template <class T, class Force = KeplerForce>
+double adaptive_floor_rms(double ecc, long* steps = nullptr, double log_tol0 = -13.75) {
   using VT = std::array<T, 2>;
   const KeplerProblem<T> kp(static_cast<T>(ecc));
   const MethodDef def = resolve_method("DP12-adaptive");
@@ -184,10 +188,8 @@ double adaptive_floor_rms(double ecc, long* steps = nullptr) {
   int n = 0;
   for (int k = 0; k <= 6; ++k) {
     AdaptiveOptions opt;
-    opt.rtol = std::pow(10.0, -13.75 - k / 8.0);
-    EngineOptions eopt;
-    eopt.compensated = Compensation::automatic;
-    auto ai = make_adaptive_integrator<VT>(def, KeplerForce{}, opt, eopt);
+    opt.rtol = std::pow(10.0, log_tol0 - k / 8.0);
+    auto ai = make_adaptive_integrator<VT>(def, Force{}, opt);
     const State<VT> s0 = kp.initial_state();
     State<VT> s = s0;
     const AdaptiveStats st = ai.integrate_to(s, T(0), t_end);
@@ -216,5 +218,134 @@ TEST(Compensated, AdaptiveRknRoundOffStaysBelowItsTruncation) {
     EXPECT_LT(d, 2 * l) << ecc;
     EXPECT_LT(d, ecc < 0.7 ? 8e-13 : 1.6e-12) << ecc;
     EXPECT_NEAR(static_cast<double>(steps_d), static_cast<double>(steps_l), 0.01 * steps_l);
+  }
+}
+
+// The compensated Kepler force returns -(q + cq) / |q + cq|^3 as a + alo to a few units of the working precision
+// squared (against quadruple precision; float against double), over radii 1e-3 .. 1e3 and carries up to half an
+// ulp, where the plain force rounds at units of the working precision; its plain form is KeplerForce's bitwise.
+template <class S, class Ref>
+void expect_compensated_kepler_force(double bound_in_eps2) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> angle(0, 6.283185307179586), log_r(-3, 3), frac(-0.5, 0.5);
+  using VS = std::array<S, 2>;
+  const double eps = static_cast<double>(std::numeric_limits<S>::epsilon());
+  double worst = 0, worst_plain = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double r = std::pow(10.0, log_r(rng)), th = angle(rng);
+    const VS q{static_cast<S>(r * std::cos(th)), static_cast<S>(r * std::sin(th))};
+    VS cq{};
+    for (int i = 0; i < 2; ++i) {
+      const S ulp = std::nextafter(std::abs(q[i]), std::numeric_limits<S>::infinity()) - std::abs(q[i]);
+      cq[i] = static_cast<S>(frac(rng)) * ulp;
+    }
+    VS a{}, alo{}, plain{}, via_base{};
+    CompensatedKeplerForce{}(q, cq, a, alo);
+    CompensatedKeplerForce{}(q, plain);
+    KeplerForce{}(q, via_base);
+    ASSERT_EQ(plain, via_base);
+    const Ref x = Ref(q[0]) + Ref(cq[0]), y = Ref(q[1]) + Ref(cq[1]);
+    const Ref r2 = x * x + y * y;
+    using boost::multiprecision::abs;
+    using boost::multiprecision::sqrt;
+    using std::abs;
+    using std::sqrt;
+    const Ref m = Ref(1) / (r2 * sqrt(r2));
+    const Ref norm = m * sqrt(r2);
+    for (int i = 0; i < 2; ++i) {
+      const Ref exact = -(i == 0 ? x : y) * m;
+      worst = std::max(worst, static_cast<double>(abs(Ref(a[i]) + Ref(alo[i]) - exact) / norm));
+      worst_plain = std::max(worst_plain, static_cast<double>(abs(Ref(plain[i]) - exact) / norm));
+    }
+  }
+  std::cout << "compensated Kepler force: largest error " << worst / (eps * eps) << " eps^2; plain "
+            << worst_plain / eps << " eps\n";
+  EXPECT_LT(worst, bound_in_eps2 * eps * eps);
+  EXPECT_GT(worst_plain, 0.5 * eps);  // the plain force does round at the working precision
+}
+
+TEST(Compensated, CompensatedKeplerForceIsAccurateToTwiceTheWorkingPrecision) {
+  expect_compensated_kepler_force<double, float128>(16);
+  expect_compensated_kepler_force<float, double>(16);
+}
+
+namespace {
+
+SecondOrderProblem<V, CompensatedKeplerForce> compensated_kepler(double ecc, double t1) {
+  const KeplerProblem<double> kp(ecc);
+  const State<V> s0 = kp.initial_state();
+  return SecondOrderProblem(CompensatedKeplerForce{}, s0.q, s0.v, 0.0, t1);
+}
+
+}  // namespace
+
+// With the compensated force the precise update of DP12-adaptive takes the force's rounding error, the exact
+// weights, stage positions in double-word and a compensated velocity sum, and accepts tolerances down to eps/2.
+// At tolerances 10^-15 .. 10^-15.75 (which the plain force refuses) the rms final position error on Kepler over 100
+// periods falls to the order of the truncation (the same tolerances in long double), where the plain force stays at
+// its floor at 10^-13.75 .. 10^-14.5.
+TEST(Compensated, CompensatedForceTakesAdaptiveRknBelowThePlainForcesFloor) {
+  for (double ecc : {0.5, 0.9}) {
+    long steps_p = 0, steps_c = 0, steps_l = 0;
+    const double plain = adaptive_floor_rms<double>(ecc, &steps_p);
+    const double comp = adaptive_floor_rms<double, CompensatedKeplerForce>(ecc, &steps_c, -15.0);
+    const double ld = adaptive_floor_rms<long double>(ecc, &steps_l, -15.0);
+    std::cout << "e = " << ecc << ": rms position error, plain force " << plain << " (" << steps_p
+              << " steps), compensated force " << comp << " (" << steps_c << "), long double " << ld << " (" << steps_l
+              << ")\n";
+    EXPECT_LT(comp, 0.4 * plain) << ecc;
+    EXPECT_LT(comp, 1.2e-13) << ecc;
+    EXPECT_NEAR(static_cast<double>(steps_c), static_cast<double>(steps_l), 0.01 * steps_l);
+  }
+  // The tolerance floor: eps/2 with the compensated force, 10 eps without.
+  const MethodDef def = resolve_method("DP12-adaptive");
+  AdaptiveOptions opt;
+  opt.rtol = 1.2e-16;
+  EXPECT_NO_THROW(make_adaptive_integrator<V>(def, CompensatedKeplerForce{}, opt));
+  EXPECT_THROW(make_adaptive_integrator<V>(def, KeplerForce{}, opt), std::invalid_argument);
+  opt.rtol = 1e-16;
+  EXPECT_THROW(make_adaptive_integrator<V>(def, CompensatedKeplerForce{}, opt), std::invalid_argument);
+  // Without compensated summation the force's low part has nowhere to go: the floor is 10 eps again.
+  opt.rtol = 1.2e-16;
+  EngineOptions off;
+  off.compensated = Compensation::off;
+  EXPECT_THROW(make_adaptive_integrator<V>(def, CompensatedKeplerForce{}, opt, off), std::invalid_argument);
+}
+
+// A run with the compensated force restarts from a checkpoint bitwise, forward and backward in time: the first
+// stage after the restart evaluates the force at the state and its carry exactly as the step's last stage did.
+TEST(Compensated, CompensatedForceRunRestartsBitwiseBothDirections) {
+  const auto def = resolve_solve_method("DP12-adaptive");
+  for (double t1 : {30.0, -30.0}) {
+    SCOPED_TRACE(t1);
+    const auto prob = compensated_kepler(0.7, t1);
+    SolveOptions opt;
+    opt.rtol = 1e-15;
+    const auto plain = solve(prob, def, opt);
+    ASSERT_EQ(plain.status, SolveStatus::success);
+    opt.checkpoint_at = 0.41 * t1;
+    opt.checkpoint_problem = "kepler e=0.7 compensated";
+    std::string text;
+    opt.on_checkpoint = [&](const std::string& s) { text = s; };
+    const auto first = solve(prob, def, opt);
+    ASSERT_TRUE(first.checkpoint.has_value());
+    EXPECT_EQ(first.q_final, plain.q_final);
+    EXPECT_EQ(first.v_final, plain.v_final);
+    const auto second = resume(prob, def, checkpoint_from_text<double>(text), opt);
+    EXPECT_EQ(second.q_final, plain.q_final);
+    EXPECT_EQ(second.v_final, plain.v_final);
+    EXPECT_EQ(second.accepted, plain.accepted);
+    EXPECT_EQ(second.rejected, plain.rejected);
+    // The force is counted like any other (16 stages, first same as last).
+    EXPECT_GE(plain.force_evals, 15 * plain.accepted);
+    // And it is the orbit: against the exact one of the run's initial state at |t1| = 30.
+    const KeplerProblem<double> kp(0.7);
+    const State<V> s0 = kp.initial_state();
+    State<V> end{plain.q_final, plain.v_final};
+    if (t1 < 0) {  // the orbit from the apocentre on the x axis at -t is that at +t mirrored in the x axis
+      end.q = {end.q[0], -end.q[1]};
+      end.v = {-end.v[0], end.v[1]};
+    }
+    EXPECT_LT(kepler_reference_errors(s0, end, 30.0, 1).position, 1e-12);
   }
 }

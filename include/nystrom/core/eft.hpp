@@ -20,6 +20,15 @@ template <class S>
   return s;
 }
 
+/// s = fl(a + b), e = a + b - s exactly, for |a| >= |b| (or a = 0).
+template <class S>
+[[gnu::always_inline]] inline S fast_two_sum(S a, S b, S& e) {
+  static_assert(std::is_floating_point_v<S>);
+  const S s = a + b;
+  e = b - (s - a);
+  return s;
+}
+
 /// p = fl(a b), e = a b - p exactly (barring overflow and underflow).
 template <class S>
 [[gnu::always_inline]] inline S two_prod(S a, S b, S& e) {

@@ -79,6 +79,13 @@ template <class F, class V>
 inline constexpr bool takes_velocity_v =
     std::is_invocable_v<F&, const V&, const V&, V&> && !std::is_invocable_v<F&, const V&, V&>;
 
+/// Whether a force is also compensated, force(q, cq, a, alo) besides force(q, a): it takes the position q + cq (cq
+/// the carry of compensated summation) and returns the acceleration a + alo to about twice the working precision.
+/// The precise update of the adaptive RKN pairs (engines/rkn.hpp) uses it; every other engine calls force(q, a).
+template <class F, class V>
+inline constexpr bool takes_carry_v =
+    std::conjunction_v<std::is_invocable<F&, const V&, const V&, V&, V&>, std::is_invocable<F&, const V&, V&>>;
+
 template <class V>
 struct is_std_array : std::false_type {};
 template <class S, std::size_t N>

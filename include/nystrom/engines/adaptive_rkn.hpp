@@ -135,7 +135,22 @@ AdaptiveRknIntegrator<V, F> make_adaptive_integrator(const MethodDef& def, F for
   if (!t || t->bhat.empty())
     throw std::invalid_argument("method '" + def.info.name + "' has no embedded pair: it cannot run with a tolerance");
   auto conv = [](const bigcomplex& x) { return to_scalar<S>(x); };
-  return AdaptiveRknIntegrator<V, F>(convert_tableau<S>(*t, conv), std::move(force), opt, eopt);
+  RknTableau<S> tab = convert_tableau<S>(*t, conv);
+  if constexpr (RknStepper<V, F>::carried_force) {
+    // The rounding residuals of c, b and B: with a compensated force the step runs with the exact weights (the
+    // rounded ones bias every step the same way, below the force's rounding but above the compensated force's).
+    auto residuals = [](const std::vector<bigcomplex>& exact, const std::vector<S>& rounded) {
+      std::vector<S> r;
+      r.reserve(exact.size());
+      for (std::size_t i = 0; i < exact.size(); ++i)
+        r.push_back(to_scalar<S>(exact[i] - bigcomplex(bigfloat(rounded[i]))));
+      return r;
+    };
+    tab.c_lo = residuals(t->c, tab.c);
+    tab.b_lo = residuals(t->b, tab.b);
+    tab.B_lo = residuals(t->B, tab.B);
+  }
+  return AdaptiveRknIntegrator<V, F>(std::move(tab), std::move(force), opt, eopt);
 }
 
 }  // namespace nystrom

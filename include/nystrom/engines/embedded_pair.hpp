@@ -156,7 +156,12 @@ class EmbeddedPairIntegrator {
         compensated_(use_compensation<scalar_type>(eopt.compensated)),
         name_(name) {
     opt_.validate();
-    adaptive_detail::check_tolerance<real_type>(opt_);
+    bool compensated_force = false, could = false;
+    if constexpr (requires { Stepper::carried_force; }) {
+      compensated_force = Stepper::carried_force && compensated_;
+      could = Stepper::precise_capable && compensated_ && !compensated_force;
+    }
+    adaptive_detail::check_tolerance<real_type>(opt_, compensated_force, could);
   }
   /// The pair's orders: error_order (taken unless the options give one), the method's order (0: the error
   /// order), and whether the stepper's second estimate stretches the norm.

@@ -11,7 +11,9 @@
 // was evaluated at.
 // An optional embedded solution (bhat, Bhat) gives an error estimate for step control. The compensated steps of
 // step control (step_with_error with carries) keep their rounding below the force's in double and float
-// (precise_update).
+// (precise_update). A compensated force, force(q, cq, a, alo) (takes_carry_v; CompensatedKeplerForce), takes them
+// below that: the stage positions in double-word with the residuals of the rounded c_i, the weights' residuals, the
+// force's rounding error in the sums, and the velocity's sum as a compensated dot product.
 //
 // A general (RKNG) tableau (RknTableau::general()) also integrates a velocity-dependent force,
 // force(q, v, a): the stages are evaluated at (y_i, w_i) with w_i = v_n + h sum_{j<i} av_ij f_j
@@ -45,6 +47,9 @@ class RknStepper {
   /// Whether a compensated step with an error estimate is made in double-word arithmetic (precise_update).
   static constexpr bool precise_capable =
       (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>)&&!velocity_dependent;
+  /// Whether the precise update also takes the force's rounding error: a compensated force, force(q, cq, a, alo)
+  /// (takes_carry_v), evaluated at the stage positions with their low parts.
+  static constexpr bool carried_force = precise_capable && takes_carry_v<Force, V>;
 
   RknStepper(RknTableau<scalar_type> t, Force force, EngineOptions opt = {})
       : t_(std::move(t)), force_(std::move(force)), opt_(opt) {
@@ -62,6 +67,7 @@ class RknStepper {
         if (velocity_dependent && !(t_.av[i][j] == scalar_type(0))) nzv_.push_back({i, j, t_.av[i][j]});
       }
     f_.resize(s);
+    if constexpr (carried_force) fl_.resize(s);
     if constexpr (precise_capable) {
       // The update in difference form needs sum b = 1/2 and sum B = 1 (every method of order 2 or more).
       precise_ = weight_sum_is(t_.b, scalar_type(0.5)) && weight_sum_is(t_.B, scalar_type(1));
@@ -119,6 +125,10 @@ class RknStepper {
     const scalar_type h(hr), h2 = h * h;
     for (auto& f : f_) resize_like(f, st.q);
     resize_like(y_, st.q);
+    if constexpr (carried_force) {
+      for (auto& f : fl_) resize_like(f, st.q);
+      resize_like(ylo_, st.q);
+    }
     // The stage position and the increments: locals if fixed-size (see integrate).
     constexpr bool local = is_std_array<V>::value;
     std::conditional_t<local, V, V&> y = y_, dq = dq_, dv = dv_;
@@ -139,6 +149,7 @@ class RknStepper {
         bool reuse = same(aq_, st.q) && (!velocity_dependent || same(av_, st.v));
         if (!reuse && same(sq_, st.q) && (!velocity_dependent || same(sv_, st.v))) {
           std::swap(f_[0], f_[s - 1]);
+          if constexpr (carried_force) std::swap(fl_[0], fl_[s - 1]);
           reuse = true;
         }
         if (reuse) {
@@ -148,7 +159,28 @@ class RknStepper {
         }
       }
       // The stage position; in a precise step its increment first, with the position's carry, then q (not the
-      // first stage: its force is the one first-same-as-last evaluates at q itself, also after a restart).
+      // first stage: its force is the one first-same-as-last evaluates at q itself, also after a restart). A
+      // compensated force takes the stage position in double-word: q + c_i h v with c_i's residual and exact
+      // products, plus the carry and the small terms h^2 sum_j a_ij f_j; the first stage's is q + cq, as at the
+      // end of a step (carried_force_at).
+      if constexpr (carried_force) {
+        if (precise) {
+          assign(y, comp->cq);
+          for (; k < nz_.size() && nz_[k].i == i; ++k) axpy(y, nz_[k].a * h2, f_[nz_[k].j]);
+          scalar_type che;
+          const scalar_type ch = eft::two_prod(t_.c[i], h, che);
+          if (!t_.c_lo.empty()) che += t_.c_lo[i] * h;
+          for (std::size_t j = 0; j < y.size(); ++j) {
+            scalar_type pe, se;
+            const scalar_type p = eft::two_prod(ch, st.v[j], pe);
+            const scalar_type hi = eft::two_sum(st.q[j], p, se);
+            y[j] = eft::fast_two_sum(hi, se + (pe + che * st.v[j]) + y[j], ylo_[j]);
+          }
+          force_(static_cast<const V&>(y), static_cast<const V&>(ylo_), f_[i], fl_[i]);
+          ++evals_;
+          continue;
+        }
+      }
       const bool carried = precise && i > 0;
       assign(y, carried ? comp->cq : st.q);
       if (!(t_.c[i] == scalar_type(0))) axpy(y, t_.c[i] * h, st.v);
@@ -161,6 +193,7 @@ class RknStepper {
         force_(static_cast<const V&>(y), static_cast<const V&>(w_), f_[i]);
       } else {
         force_(y, f_[i]);
+        if constexpr (carried_force) zero_like(fl_[i], st.q);
       }
       ++evals_;
     }
@@ -176,10 +209,18 @@ class RknStepper {
     // only, the last stage at q_{n+1} and v's with it; for a velocity-dependent force v's first (B_s = 0 is
     // required, see the constructor) and the last stage at (q_{n+1}, v_{n+1}).
     auto last_stage = [&] {
+      if constexpr (carried_force) {
+        if (precise) {
+          assign(y, comp->cq);
+          carried_force_at(st.q, y, s - 1);
+          return;
+        }
+      }
       if constexpr (velocity_dependent)
         force_(static_cast<const V&>(st.q), static_cast<const V&>(st.v), f_[s - 1]);
       else
         force_(static_cast<const V&>(st.q), f_[s - 1]);
+      if constexpr (carried_force) zero_like(fl_[s - 1], st.q);
       ++evals_;
     };
     const bool v_first = at_end && velocity_dependent;
@@ -252,6 +293,7 @@ class RknStepper {
     if (at_end) {
       // The last stage was evaluated at the step's result: the next step's first force.
       std::swap(f_[0], f_[s - 1]);
+      if constexpr (carried_force) std::swap(fl_[0], fl_[s - 1]);
       resize_like(aq_, st.q);
       assign(aq_, st.q);
       if constexpr (velocity_dependent) {
@@ -279,32 +321,80 @@ class RknStepper {
     using eft::two_prod;
     using eft::two_sum;
     const std::size_t s = t_.stages(), n = st.q.size();
+    const bool residuals = carried_force && !t_.b_lo.empty() && !t_.B_lo.empty();
     scalar_type h2e;
     two_prod(h, h, h2e);
     const scalar_type hh = scalar_type(0.5) * h2, hhe = scalar_type(0.5) * h2e;
     for (std::size_t j = 0; j < n; ++j) {
       const scalar_type f1 = f_[0][j];
-      scalar_type sb = 0;
-      for (std::size_t i = 1; i < ns; ++i) sb += t_.b[i] * (f_[i][j] - f1);
+      scalar_type sb = 0, sbl = 0, f1l = 0;  // sbl: sum of the weights' residuals times the differences
+      if constexpr (carried_force) f1l = fl_[0][j];
+      for (std::size_t i = 1; i < ns; ++i) {
+        scalar_type d = f_[i][j] - f1;
+        if constexpr (carried_force) {
+          d += fl_[i][j] - f1l;
+          if (residuals) sbl += t_.b_lo[i] * d;
+        }
+        sb += t_.b[i] * d;
+      }
       scalar_type e1, e2, e3, e4;
       const scalar_type p1 = two_prod(h, st.v[j], e1);
       const scalar_type p2 = two_prod(hh, f1, e2);
       const scalar_type s1 = two_sum(st.q[j], p1, e3);
       const scalar_type s2 = two_sum(s1, p2, e4);
-      const scalar_type low = (e3 + e4) + (c.cq[j] + (e1 + e2)) + (hhe * f1 + h * c.cv[j] + h2 * sb);
+      scalar_type low = (e3 + e4) + (c.cq[j] + (e1 + e2));
+      if constexpr (carried_force)
+        low += hhe * f1 + hh * f1l + h * c.cv[j] + h2 * sb + h2 * sbl;
+      else
+        low += hhe * f1 + h * c.cv[j] + h2 * sb;
       st.q[j] = two_sum(s2, low, c.cq[j]);
     }
     if (at_end) last_stage();
     for (std::size_t j = 0; j < n; ++j) {
       const scalar_type f1 = f_[0][j];
-      scalar_type sB = 0;
-      for (std::size_t i = 1; i < s; ++i) sB += t_.B[i] * (f_[i][j] - f1);
       scalar_type e1, e2;
       const scalar_type p = two_prod(h, f1, e1);
       const scalar_type s1 = two_sum(st.v[j], p, e2);
-      const scalar_type low = e2 + (c.cv[j] + e1) + h * sB;
-      st.v[j] = two_sum(s1, low, c.cv[j]);
+      scalar_type low = e2 + (c.cv[j] + e1);
+      if constexpr (carried_force) {
+        // With a compensated force, sum_{i>1} B_i (f_i - f_1) as a compensated dot product (Ogita, Rump and
+        // Oishi's Dot2) and h times it as an exact product: the velocity's increment is then rounded at the
+        // working precision squared, its rounding no longer a random walk of the energy.
+        const scalar_type f1l = fl_[0][j];
+        scalar_type sB = 0, sBl = 0;
+        for (std::size_t i = 1; i < s; ++i) {
+          scalar_type de, pe, se;
+          const scalar_type d = two_sum(f_[i][j], -f1, de);
+          const scalar_type dl = de + (fl_[i][j] - f1l);
+          const scalar_type pr = two_prod(t_.B[i], d, pe);
+          sB = two_sum(sB, pr, se);
+          sBl += se + pe + t_.B[i] * dl;
+          if (residuals) sBl += t_.B_lo[i] * d;
+        }
+        scalar_type hse, e3;
+        const scalar_type hs = two_prod(h, sB, hse);
+        const scalar_type s2 = two_sum(s1, hs, e3);
+        low += e3 + (h * f1l + hse + h * sBl);
+        st.v[j] = two_sum(s2, low, c.cv[j]);
+      } else {
+        scalar_type sB = 0;
+        for (std::size_t i = 1; i < s; ++i) sB += t_.B[i] * (f_[i][j] - f1);
+        low += h * sB;
+        st.v[j] = two_sum(s1, low, c.cv[j]);
+      }
     }
+  }
+
+  // The compensated force at the stage position q + y (y its increment with the position's carry), split by a
+  // two-sum into the high part (in y) and the low part, into stage i's force and its rounding error.
+  NYSTROM_ALWAYS_INLINE void carried_force_at(const V& q, V& y, std::size_t i) {
+    for (std::size_t j = 0; j < y.size(); ++j) y[j] = eft::two_sum(q[j], y[j], ylo_[j]);
+    force_(static_cast<const V&>(y), static_cast<const V&>(ylo_), f_[i], fl_[i]);
+    ++evals_;
+  }
+  static void zero_like(V& x, const V& like) {
+    resize_like(x, like);
+    for (auto& e : x) e = scalar_type(0);
   }
 
   // Whether the weights sum to target up to their rounding (an error-free sum).
@@ -332,7 +422,8 @@ class RknStepper {
   bool fsal_ = false;
   std::vector<Nz> nz_, nzv_;
   std::vector<V> f_;
-  V y_{}, w_{};
+  std::vector<V> fl_;  // a compensated force's rounding errors (carried_force)
+  V y_{}, w_{}, ylo_{};
   V aq_{}, av_{};  // the end of the last step (its force is f_[0])
   V sq_{}, sv_{};  // its start (its force is f_[s-1])
   V dq_{}, dv_{};

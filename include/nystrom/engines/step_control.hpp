@@ -90,13 +90,18 @@ class ErrorScale {
   bool mixed_;
 };
 
-/// Refuses a tolerance below what the scalar type R resolves (10 eps).
+/// Refuses a tolerance below what the scalar type R resolves: 10 eps, or eps / 2 for a run whose increments and
+/// force are compensated (a compensated force, takes_carry_v, in the adaptive RKN pairs' precise update);
+/// could_compensate: the message names that way down.
 template <class R>
-void check_tolerance(const AdaptiveOptions& opt) {
-  const double min_tol = 10 * as_double(epsilon_of<R>());
+void check_tolerance(const AdaptiveOptions& opt, bool compensated_force = false, bool could_compensate = false) {
+  const double eps = as_double(epsilon_of<R>());
+  const double min_tol = compensated_force ? eps / 2 : 10 * eps;
   if (opt.rtol > 0 && opt.rtol < min_tol)
     throw std::invalid_argument("tolerance " + sci(opt.rtol) + " is below what " + scalar_traits<R>::name() +
-                                " resolves (10 eps = " + sci(min_tol) + "); use a wider precision");
+                                " resolves (" + (compensated_force ? "eps / 2 = " : "10 eps = ") + sci(min_tol) +
+                                (could_compensate ? "; eps / 2 with a compensated force" : "") +
+                                "); use a wider precision");
 }
 
 /// Hairer's starting step (HNW I, II.4) for y' = F(y), y = (q, v), F = (v, a(q)): two force

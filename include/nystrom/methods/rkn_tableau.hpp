@@ -26,6 +26,9 @@ struct RknTableau {
   // Hairer's stretched estimate err^2 / sqrt(err^2 + 0.01 err_low^2), which behaves like the main solution's
   // own error (order general_order - 1 in the controller's exponent; HNW I, sec. II.10).
   std::vector<C> blow, Blow;
+  // Optional rounding residuals of c, b and B (the exact values minus the stored ones), for a tableau rounded
+  // from a wider one: the precise update with a compensated force uses them (engines/rkn.hpp). Empty: unknown.
+  std::vector<C> c_lo, b_lo, B_lo;
 
   /// Whether the tableau integrates velocity-dependent forces (it has velocity coefficients).
   bool general() const { return !av.empty(); }
@@ -45,6 +48,8 @@ struct RknTableau {
       throw std::invalid_argument("RKN tableau: embedded weights have the wrong size");
     if (!blow.empty() && (bhat.empty() || blow.size() != s || Blow.size() != s))
       throw std::invalid_argument("RKN tableau: the second embedded weights have the wrong size");
+    for (const auto* r : {&c_lo, &b_lo, &B_lo})
+      if (!r->empty() && r->size() != s) throw std::invalid_argument("RKN tableau: a residual has the wrong size");
     if (general()) {
       if (av.size() != s) throw std::invalid_argument("RKNG tableau: av has the wrong size");
       for (std::size_t i = 0; i < s; ++i) {

@@ -123,6 +123,12 @@ struct EngineForce {
       a[n] = typename VE::value_type(0);
     }
   }
+  // A compensated force (takes_carry_v) keeps its form for the precise update of the adaptive RKN pairs.
+  void operator()(const VE& q, const VE& cq, VE& a, VE& alo) requires(!VD && !TD && takes_carry_v<F, VE>) {
+    f(q, cq, a, alo);
+    check_size(a, q.size());
+    check_size(alo, q.size());
+  }
   void operator()(const VE& q, const VE& v, VE& a) requires(VD) {
     if constexpr (!TD) {
       if (dir > 0) {
