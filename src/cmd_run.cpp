@@ -113,6 +113,10 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_option("--tol", o->req.tol, "Tolerance of an adaptive method (e.g. DP12-adaptive)")
       ->check(nystrom::cli::tolerance_check());
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
+  app.add_option("--force", o->req.force,
+                 "Kepler: plain, or compensated (the force with its rounding error, double-word; used by the "
+                 "adaptive RKN pairs in double, whose tolerance may then go down to eps/2)")
+      ->capture_default_str();
   app.add_option("--output-times", o->sreq.output_times,
                  "Kepler: A:B:N, the state at N equally spaced times from A to B (listed after the table; JSON "
                  "`output`)");

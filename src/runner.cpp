@@ -69,6 +69,7 @@ nlohmann::json RunReport::to_json() const {
                    {"energy_error", num(energy_error)},
                    {"position_error", num(position_error)},
                    {"seconds", num(seconds)}};
+  if (!force.empty()) j["force"] = force;
   if (!q.empty()) {  // the final state, each number to 17 significant digits (it reads back to the same double)
     j["t"] = num(t);
     j["q"] = q;
@@ -140,6 +141,14 @@ void check_run_request(const RunRequest& req, const MethodDef& def) {
     throw UsageError("method '" + def.info.name + "' is adaptive: give a positive --tol");
   if (!def.info.adaptive && req.tol != 0)
     throw UsageError("--tol applies to adaptive methods only; '" + def.info.name + "' runs with fixed steps");
+  if (req.force != "plain") {
+    if (req.force != "compensated") throw UsageError("--force must be plain or compensated, got '" + req.force + "'");
+    if (req.problem != "kepler") throw UsageError("--force compensated applies to --problem kepler");
+    if (req.precision != "double") throw UsageError("--force compensated runs in --precision double");
+    if (!(def.info.adaptive && def.info.family == "rkn"))
+      throw UsageError("--force compensated is used by the adaptive RKN pairs (DP12-adaptive, DOP853-adaptive); '" +
+                       def.info.name + "' would ignore it");
+  }
 }
 
 void label_report(RunReport& r, const RunRequest& req, const MethodDef& def) {
@@ -148,6 +157,7 @@ void label_report(RunReport& r, const RunRequest& req, const MethodDef& def) {
   r.order = def.info.order;
   r.problem = req.problem;
   r.precision = req.precision;
+  if (req.problem == "kepler" || req.problem == "harmonic") r.force = req.force;
 }
 
 RunReport run_case(const RunRequest& req, const MethodDef& def) {

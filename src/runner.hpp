@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -20,8 +21,9 @@ struct RunRequest {
   long steps_per_period = 1000;    // steps per orbital period
   long periods = 10;               // whole periods integrated
   std::string precision = "double";
-  bool keep_complex = false;  // complex methods: keep the complexified state
-  double tol = 0;             // adaptive methods: tolerance (required for them, refused otherwise)
+  bool keep_complex = false;    // complex methods: keep the complexified state
+  double tol = 0;               // adaptive methods: tolerance (required for them, refused otherwise)
+  std::string force = "plain";  // kepler: plain (KeplerForce) or compensated (CompensatedKeplerForce)
   // nbody / twobody (double precision):
   long n = 400;             // Plummer particles
   unsigned long seed = 42;  // Plummer sample
@@ -68,6 +70,12 @@ struct MeteredForce {
     f(q, a);
     if (--left == 0) left = meter ? meter->tick() : std::numeric_limits<long>::max();
   }
+  template <class Q, class A>
+  requires std::is_invocable_v<const F&, const Q&, const Q&, A&, A&>
+  void operator()(const Q& q, const Q& cq, A& a, A& alo) const {
+    f(q, cq, a, alo);
+    if (--left == 0) left = meter ? meter->tick() : std::numeric_limits<long>::max();
+  }
 };
 
 /// The Gragg-Bulirsch-Stoer reference integrator is a method of `run`/`sweep` too, named "GBS"
@@ -79,6 +87,7 @@ MethodDef resolve_run_method(const std::string& spec);
 struct RunReport {
   static constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   std::string method, family, problem, precision;
+  std::string force;  // kepler and harmonic runs: the force form (RunRequest::force)
   int order = 0;
   double ecc = nan;
   long steps = 0;

@@ -75,9 +75,9 @@ SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq,
   // What a checkpoint must match: everything that defines the steps, except the end of the span.
   const bool tolerance = def.info.adaptive;
   char tag[256];
-  std::snprintf(tag, sizeof tag, "kepler ecc=%a precision=double %s=%a keep_complex=%d", req.ecc,
+  std::snprintf(tag, sizeof tag, "kepler ecc=%a precision=double %s=%a keep_complex=%d%s", req.ecc,
                 tolerance ? "tol" : "steps_per_period", tolerance ? req.tol : static_cast<double>(req.steps_per_period),
-                req.keep_complex ? 1 : 0);
+                req.keep_complex ? 1 : 0, req.force == "compensated" ? " force=compensated" : "");
   outputs.checkpoint_problem = tag;
   if (!sreq.checkpoint.empty()) {
     if (!(sreq.checkpoint_at >= 0) || !std::isfinite(sreq.checkpoint_at))

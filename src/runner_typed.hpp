@@ -30,12 +30,13 @@ inline long expected_evals(const MethodDef& def, long n) { return n * std::max(1
 
 }  // namespace detail
 
-template <class T, std::size_t N>
-OrbitRun<T, N> run_orbit(const RunRequest& req, const MethodDef& def, const RunOutputs<std::array<T, N>>& outputs) {
+/// The run with the force Force (KeplerForce, CompensatedKeplerForce or HarmonicForce).
+template <class T, std::size_t N, class Force>
+OrbitRun<T, N> run_orbit_with(const RunRequest& req, const MethodDef& def,
+                              const RunOutputs<std::array<T, N>>& outputs) {
   static_assert(N == 1 || N == 2, "Kepler (N = 2) or the harmonic oscillator (N = 1)");
   constexpr bool kepler = N == 2;
   using Problem = std::conditional_t<kepler, KeplerProblem<T>, HarmonicProblem<T>>;
-  using Force = std::conditional_t<kepler, KeplerForce, HarmonicForce>;
   if (kepler && (!std::isfinite(req.ecc) || req.ecc < 0 || req.ecc >= 1))
     throw UsageError("--ecc must satisfy 0 <= e < 1 for the Kepler problem");
   const Problem problem = [&] {
@@ -111,6 +112,15 @@ OrbitRun<T, N> run_orbit(const RunRequest& req, const MethodDef& def, const RunO
     r.v.push_back(as_double(s.v[i]));
   }
   return out;
+}
+
+template <class T, std::size_t N>
+OrbitRun<T, N> run_orbit(const RunRequest& req, const MethodDef& def, const RunOutputs<std::array<T, N>>& outputs) {
+  if constexpr (N == 2 && std::is_same_v<T, double>) {
+    if (req.force == "compensated") return run_orbit_with<T, N, CompensatedKeplerForce>(req, def, outputs);
+  }
+  if (req.force != "plain") throw UsageError("--force compensated runs the kepler problem in double precision");
+  return run_orbit_with<T, N, std::conditional_t<N == 2, KeplerForce, HarmonicForce>>(req, def, outputs);
 }
 
 /// Kepler or harmonic run of `def` in scalar type T (validated request).

@@ -68,14 +68,20 @@ def _rebuild(cls, state):
 
 class Kepler(Problem):
     """The planar Kepler problem a = -q/|q|^3 of Chin (2010), eqs (35)-(36): q0 = (1+e, 0),
-    v0 = (0, sqrt((1-e)/(1+e))), energy -1/2, period 2 pi, started at apocentre."""
+    v0 = (0, sqrt((1-e)/(1+e))), energy -1/2, period 2 pi, started at apocentre.
 
-    _kind = "kepler"
+    compensated=True: the force in double-word arithmetic (CompensatedKeplerForce), which the adaptive RKN pairs
+    (DP12-adaptive, DOP853-adaptive) in double use to go below the plain force's rounding, with tolerances down to
+    eps/2; other methods and precisions are refused, as by `nystrom run --force compensated`."""
 
-    def __init__(self, e=0.9):
+    def __init__(self, e=0.9, compensated=False):
         e = _real("e", e)
         if not 0 <= e < 1:
             raise ValueError(f"eccentricity must satisfy 0 <= e < 1, got {e!r}")
+        if not isinstance(compensated, bool):
+            raise TypeError(f"compensated must be True or False, got {compensated!r}")
+        self._kind = "kepler_compensated" if compensated else "kepler"
+        self.compensated = compensated
         self.e = e
         self.q0 = np.array([1 + e, 0.0])
         self.v0 = np.array([0.0, math.sqrt((1 - e) / (1 + e))])

@@ -341,6 +341,8 @@ PYBIND11_MODULE(_core, m) {
           return solve_python_force(std::move(force), std::move(shape), r, velocity);
         }
         if (precision == "double") return solve_builtin_double(problem, params, r);
+        if (problem == "kepler_compensated")
+          throw invalid_input("compensated=True runs in double precision, not '" + precision + "'");
         return solve_builtin_extended(problem, params, r, precision);
       },
       py::arg("problem"), py::arg("params"), py::arg("force"), py::arg("shape"), py::arg("q0"), py::arg("v0"),

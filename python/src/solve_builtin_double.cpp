@@ -11,6 +11,14 @@ namespace nystrom::python {
 
 py::dict solve_builtin_double(const std::string& problem, const std::vector<double>& params, const SolveRequest& r) {
   if (problem == "kepler") return run_solve<std::array<double, 2>>(KeplerForce{}, r, false);
+  if (problem == "kepler_compensated") {
+    // Kepler(e, compensated=True): the force in double-word, used by the adaptive RKN pairs (as the tool's
+    // `run --force compensated`, with the same refusal).
+    if (!(r.method.info.adaptive && r.method.info.family == "rkn"))
+      throw invalid_input("compensated=True is used by the adaptive RKN pairs (DP12-adaptive, DOP853-adaptive); '" +
+                          r.method.info.name + "' would ignore it");
+    return run_solve<std::array<double, 2>>(CompensatedKeplerForce{}, r, false);
+  }
   if (problem == "nbody") {
     std::vector<double> gm(params.begin() + 1, params.end());
     if (gm.size() * 3 != r.q0.size()) throw invalid_input("N-body state must hold 3 coordinates per particle");
