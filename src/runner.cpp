@@ -13,6 +13,7 @@
 #include "experiments/nbody_run.hpp"
 #include "nystrom/core/precision.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/methods/compensated_force.hpp"
 
 namespace nystrom::cli {
 
@@ -145,9 +146,8 @@ void check_run_request(const RunRequest& req, const MethodDef& def) {
     if (req.force != "compensated") throw UsageError("--force must be plain or compensated, got '" + req.force + "'");
     if (req.problem != "kepler") throw UsageError("--force compensated applies to --problem kepler");
     if (req.precision != "double") throw UsageError("--force compensated runs in --precision double");
-    if (!(def.info.adaptive && def.info.family == "rkn"))
-      throw UsageError("--force compensated is used by the adaptive RKN pairs (DP12-adaptive, DOP853-adaptive); '" +
-                       def.info.name + "' would ignore it");
+    if (!uses_compensated_force(def.info))
+      throw UsageError(compensated_force_refusal("--force compensated", def.info.name));
   }
 }
 

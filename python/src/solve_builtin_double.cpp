@@ -2,6 +2,7 @@
 #include <array>
 #include <vector>
 
+#include "nystrom/methods/compensated_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/problems/nbody.hpp"
 #include "nystrom/solve_inline.hpp"  // Kepler on std::array: the driver compiled for its force
@@ -14,9 +15,8 @@ py::dict solve_builtin_double(const std::string& problem, const std::vector<doub
   if (problem == "kepler_compensated") {
     // Kepler(e, compensated=True): the force in double-word, used by the adaptive RKN pairs (as the tool's
     // `run --force compensated`, with the same refusal).
-    if (!(r.method.info.adaptive && r.method.info.family == "rkn"))
-      throw invalid_input("compensated=True is used by the adaptive RKN pairs (DP12-adaptive, DOP853-adaptive); '" +
-                          r.method.info.name + "' would ignore it");
+    if (!uses_compensated_force(r.method.info))
+      throw invalid_input(compensated_force_refusal("compensated=True", r.method.info.name));
     return run_solve<std::array<double, 2>>(CompensatedKeplerForce{}, r, false);
   }
   if (problem == "nbody") {
