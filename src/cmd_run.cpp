@@ -114,8 +114,9 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
       ->check(nystrom::cli::tolerance_check());
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
   app.add_option("--force", o->req.force,
-                 "Kepler: plain, or compensated (the force with its rounding error, double-word; used by the "
-                 "adaptive RKN pairs in double, whose tolerance may then go down to eps/2)")
+                 "kepler, twobody, nbody: plain, or compensated (the force with its rounding error, double-word; "
+                 "used in double by the fixed-step splitting, composition and multi-product methods and by the "
+                 "adaptive RKN pairs, whose tolerance may then go down to eps/2)")
       ->capture_default_str();
   app.add_option("--output-times", o->sreq.output_times,
                  "Kepler: A:B:N, the state at N equally spaced times from A to B (listed after the table; JSON "
@@ -128,6 +129,7 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
                  "Kepler: continue from a checkpoint file (the other options must match)");
   app.add_flag("--json", o->json, "Print one JSON object");
   return [o]() {
+    nystrom::cli::check_force_option(o->req);  // the problems that have no compensated force refuse it
     if (o->req.problem == "outer-solar-system") {
       nystrom::cli::PlanetaryRequest p{.method = o->method,
                                        .h = o->h_given ? o->req.h : 100.0,

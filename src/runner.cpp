@@ -110,7 +110,9 @@ RunReport run_nbody_case(const RunRequest& req, const MethodDef& def) {
   }
   NBodyRunResult r;
   try {
-    r = run_nbody(def.info.name, setup, h, steps, def.info.adaptive ? req.tol : 0.0);
+    const double tol = def.info.adaptive ? req.tol : 0.0;
+    r = req.force == "compensated" ? run_nbody_compensated(def.info.name, setup, h, steps, tol)
+                                   : run_nbody(def.info.name, setup, h, steps, tol);
   } catch (const invalid_input& e) {
     throw UsageError(e.what());
   }
@@ -142,13 +144,17 @@ void check_run_request(const RunRequest& req, const MethodDef& def) {
     throw UsageError("method '" + def.info.name + "' is adaptive: give a positive --tol");
   if (!def.info.adaptive && req.tol != 0)
     throw UsageError("--tol applies to adaptive methods only; '" + def.info.name + "' runs with fixed steps");
-  if (req.force != "plain") {
-    if (req.force != "compensated") throw UsageError("--force must be plain or compensated, got '" + req.force + "'");
-    if (req.problem != "kepler") throw UsageError("--force compensated applies to --problem kepler");
-    if (req.precision != "double") throw UsageError("--force compensated runs in --precision double");
-    if (!uses_compensated_force(def.info))
-      throw UsageError(compensated_force_refusal("--force compensated", def.info.name));
-  }
+  check_force_option(req);
+  if (req.force != "plain" && !uses_compensated_force(def.info))
+    throw UsageError(compensated_force_refusal("--force compensated", def.info.name));
+}
+
+void check_force_option(const RunRequest& req) {
+  if (req.force == "plain") return;
+  if (req.force != "compensated") throw UsageError("--force must be plain or compensated, got '" + req.force + "'");
+  if (req.problem != "kepler" && req.problem != "twobody" && req.problem != "nbody")
+    throw UsageError("--force compensated applies to --problem kepler, twobody and nbody");
+  if (req.precision != "double") throw UsageError("--force compensated runs in --precision double");
 }
 
 void label_report(RunReport& r, const RunRequest& req, const MethodDef& def) {
@@ -157,7 +163,8 @@ void label_report(RunReport& r, const RunRequest& req, const MethodDef& def) {
   r.order = def.info.order;
   r.problem = req.problem;
   r.precision = req.precision;
-  if (req.problem == "kepler" || req.problem == "harmonic") r.force = req.force;
+  if (req.problem == "kepler" || req.problem == "harmonic" || req.problem == "twobody" || req.problem == "nbody")
+    r.force = req.force;
 }
 
 RunReport run_case(const RunRequest& req, const MethodDef& def) {

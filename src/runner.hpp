@@ -23,7 +23,7 @@ struct RunRequest {
   std::string precision = "double";
   bool keep_complex = false;    // complex methods: keep the complexified state
   double tol = 0;               // adaptive methods: tolerance (required for them, refused otherwise)
-  std::string force = "plain";  // kepler: plain (KeplerForce) or compensated (CompensatedKeplerForce)
+  std::string force = "plain";  // kepler, twobody, nbody: plain or compensated (CompensatedKeplerForce, ...NBodyForce)
   // nbody / twobody (double precision):
   long n = 400;             // Plummer particles
   unsigned long seed = 42;  // Plummer sample
@@ -87,7 +87,7 @@ MethodDef resolve_run_method(const std::string& spec);
 struct RunReport {
   static constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   std::string method, family, problem, precision;
-  std::string force;  // kepler and harmonic runs: the force form (RunRequest::force)
+  std::string force;  // kepler, harmonic, twobody and nbody runs: the force form (RunRequest::force)
   int order = 0;
   double ecc = nan;
   long steps = 0;
@@ -113,6 +113,9 @@ RunReport run_case(const RunRequest& req, const MethodDef& method);
 /// run_case's checks of a request for `method` that hold for every problem (the steps, the periods, the
 /// tolerance; throws UsageError).
 void check_run_request(const RunRequest& req, const MethodDef& method);
+/// The --force option alone: plain, or compensated for the problems that have a compensated force (kepler, twobody,
+/// nbody) in double; UsageError otherwise.
+void check_force_option(const RunRequest& req);
 
 /// Fills the method, its family and order, the problem and the precision of a report.
 void label_report(RunReport& r, const RunRequest& req, const MethodDef& method);

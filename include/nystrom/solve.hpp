@@ -15,10 +15,11 @@
 // This header is light: on std::vector states of double, long double (and, with nystrom/core/precision.hpp,
 // float128, double-double, quad-double and MPFR) solve() calls the drivers compiled in libnystrom, with the
 // force behind ErasedForce (one indirect call per force evaluation); link nystrom::nystrom (or -lnystrom).
-// Other states (std::array, float, a state type of your own) run on the inline path, where the whole driver
-// is compiled in your program for your force: #include <nystrom/solve_inline.hpp> for them, or to inline a
-// cheap force into the engine's loop on std::vector (solve_inline(), the same arguments and bitwise the same
-// results). How the drivers work: nystrom/solve/drivers.hpp.
+// Other states (std::array, float, a state type of your own) and forces with the compensated form
+// force(q, cq, a, alo) (core/state.hpp, takes_carry_v; the compiled drivers call force(q, a) only) run on the inline
+// path, where the whole driver is compiled in your program for your force: #include <nystrom/solve_inline.hpp> for
+// them, or to inline a cheap force into the engine's loop on std::vector (solve_inline(), the same arguments and
+// bitwise the same results). How the drivers work: nystrom/solve/drivers.hpp.
 #pragma once
 
 #include <string>
@@ -42,7 +43,7 @@ namespace nystrom {
 template <class V, class F>
 Solution<V> solve(const SecondOrderProblem<V, F>& problem, const std::string& method, const SolveOptions& options = {},
                   const std::vector<Event<V>>& events = {}) {
-  if constexpr (is_compiled_state<V>::value) {
+  if constexpr (is_compiled_state<V>::value && !takes_carry_v<F, V>) {
     return compiled::solve<typename V::value_type>(erase(problem), nullptr, method, options, events, nullptr);
   } else {
     return solve_inline(problem, method, options, events);  // std::array etc.: #include <nystrom/solve_inline.hpp>
@@ -53,7 +54,7 @@ Solution<V> solve(const SecondOrderProblem<V, F>& problem, const std::string& me
 template <class V, class F>
 Solution<V> solve(const SecondOrderProblem<V, F>& problem, const MethodDef& method, const SolveOptions& options = {},
                   const std::vector<Event<V>>& events = {}) {
-  if constexpr (is_compiled_state<V>::value) {
+  if constexpr (is_compiled_state<V>::value && !takes_carry_v<F, V>) {
     return compiled::solve<typename V::value_type>(erase(problem), &method, std::string(), options, events, nullptr);
   } else {
     return solve_inline(problem, method, options, events);  // std::array etc.: #include <nystrom/solve_inline.hpp>
@@ -67,7 +68,7 @@ template <class V, class F>
 Solution<V> resume(const SecondOrderProblem<V, F>& problem, const MethodDef& method,
                    const Checkpoint<real_t<typename V::value_type>>& from, const SolveOptions& options = {},
                    const std::vector<Event<V>>& events = {}) {
-  if constexpr (is_compiled_state<V>::value) {
+  if constexpr (is_compiled_state<V>::value && !takes_carry_v<F, V>) {
     return compiled::solve<typename V::value_type>(erase(problem), &method, std::string(), options, events, &from);
   } else {
     return resume_inline(problem, method, from, options, events);  // std::array: #include <nystrom/solve_inline.hpp>
@@ -78,7 +79,7 @@ template <class V, class F>
 Solution<V> resume(const SecondOrderProblem<V, F>& problem, const std::string& method,
                    const Checkpoint<real_t<typename V::value_type>>& from, const SolveOptions& options = {},
                    const std::vector<Event<V>>& events = {}) {
-  if constexpr (is_compiled_state<V>::value) {
+  if constexpr (is_compiled_state<V>::value && !takes_carry_v<F, V>) {
     return compiled::solve<typename V::value_type>(erase(problem), nullptr, method, options, events, &from);
   } else {
     return resume_inline(problem, method, from, options, events);  // std::array: #include <nystrom/solve_inline.hpp>

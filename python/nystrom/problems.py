@@ -70,9 +70,10 @@ class Kepler(Problem):
     """The planar Kepler problem a = -q/|q|^3 of Chin (2010), eqs (35)-(36): q0 = (1+e, 0),
     v0 = (0, sqrt((1-e)/(1+e))), energy -1/2, period 2 pi, started at apocentre.
 
-    compensated=True: the force in double-word arithmetic (CompensatedKeplerForce), which the adaptive RKN pairs
-    (DP12-adaptive, DOP853-adaptive) in double use to go below the plain force's rounding, with tolerances down to
-    eps/2; other methods and precisions are refused, as by `nystrom run --force compensated`."""
+    compensated=True: the force in double-word arithmetic (CompensatedKeplerForce), which the fixed-step splitting,
+    composition and multi-product methods (SS10, KL8, M8, ...) and the adaptive RKN pairs (DP12-adaptive,
+    DOP853-adaptive, tolerances then down to eps/2) in double use to go below the plain force's rounding; other
+    methods and precisions are refused, as by `nystrom run --force compensated`."""
 
     def __init__(self, e=0.9, compensated=False):
         e = _real("e", e)
@@ -168,11 +169,17 @@ class NBody(Problem):
         sim.add(m=1e-3, x=1.0, vy=1.0)
 
     State arrays have shape (N, 3). ``eps`` is the softening length.
+
+    compensated=True: the force in double-word arithmetic (CompensatedNBodyForce), which the fixed-step splitting,
+    composition and multi-product methods and the adaptive RKN pairs in double use to go below the plain force's
+    rounding; other methods and precisions are refused, as by `nystrom run --force compensated`.
     """
 
-    _kind = "nbody"
-
-    def __init__(self, masses=None, G=1.0, eps=0.0):
+    def __init__(self, masses=None, G=1.0, eps=0.0, compensated=False):
+        if not isinstance(compensated, bool):
+            raise TypeError(f"compensated must be True or False, got {compensated!r}")
+        self._kind = "nbody_compensated" if compensated else "nbody"
+        self.compensated = compensated
         self.G = _real("G", G)
         if not self.G > 0:
             raise ValueError(f"G must be positive, got {self.G!r}")
@@ -238,14 +245,15 @@ class NBody(Problem):
 class Plummer(NBody):
     """A Plummer sphere of n equal-mass particles in standard units (total mass 1, G = 1, E = -1/4),
     sampled with seed (Aarseth, Hénon & Wielen, Astron. Astrophys. 37 (1974) 183); softening
-    eps = 1/n unless given."""
+    eps = 1/n unless given; compensated as for NBody."""
 
-    def __init__(self, n, seed=42, eps=None):
+    def __init__(self, n, seed=42, eps=None, compensated=False):
         if isinstance(n, bool) or not isinstance(n, numbers.Integral):
             raise TypeError(f"n must be an integer, got {type(n).__name__}")
         if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
             raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
-        super().__init__(G=1.0, eps=1.0 / n if eps is None and n > 0 else (0.0 if eps is None else eps))
+        super().__init__(G=1.0, eps=1.0 / n if eps is None and n > 0 else (0.0 if eps is None else eps),
+                         compensated=compensated)
         m, q, v = _core.plummer(int(n), int(seed))
         self.masses = [float(x) for x in m]
         self._q = q.tolist()

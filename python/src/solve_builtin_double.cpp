@@ -5,7 +5,7 @@
 #include "nystrom/methods/compensated_force.hpp"
 #include "nystrom/problems/kepler.hpp"
 #include "nystrom/problems/nbody.hpp"
-#include "nystrom/solve_inline.hpp"  // Kepler on std::array: the driver compiled for its force
+#include "nystrom/solve_inline.hpp"  // Kepler on std::array, the compensated N-body force: the driver compiled for them
 #include "solve_binding.hpp"
 
 namespace nystrom::python {
@@ -19,10 +19,16 @@ py::dict solve_builtin_double(const std::string& problem, const std::vector<doub
       throw invalid_input(compensated_force_refusal("compensated=True", r.method.info.name));
     return run_solve<std::array<double, 2>>(CompensatedKeplerForce{}, r, false);
   }
-  if (problem == "nbody") {
+  if (problem == "nbody" || problem == "nbody_compensated") {
     std::vector<double> gm(params.begin() + 1, params.end());
     if (gm.size() * 3 != r.q0.size()) throw invalid_input("N-body state must hold 3 coordinates per particle");
-    return run_solve<std::vector<double>>(NBodyForce<double>(std::move(gm), params.at(0)), r, false);
+    if (problem == "nbody")
+      return run_solve<std::vector<double>>(NBodyForce<double>(std::move(gm), params.at(0)), r, false);
+    // NBody(compensated=True): the force in double-word (CompensatedNBodyForce, on the inline path), as the tool's
+    // `run --problem nbody --force compensated`, with the same refusal.
+    if (!uses_compensated_force(r.method.info))
+      throw invalid_input(compensated_force_refusal("compensated=True", r.method.info.name));
+    return run_solve<std::vector<double>>(CompensatedNBodyForce<double>(std::move(gm), params.at(0)), r, false);
   }
   if (problem == "henon_heiles" || problem == "harmonic")
     return run_solve<std::vector<double>>(SmallProblemForce::of(problem, params, r.q0.size()), r, false);

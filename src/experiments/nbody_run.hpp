@@ -2,7 +2,8 @@
 // solve(): `steps` steps of size h with a catalog method (real or complex coefficients), or GBS at a
 // tolerance (method "GBS"), and report the relative energy error and the position error against a GBS
 // reference run of the same length (tolerance ref_tol). For twobody the position error is also measured
-// against the exact orbit of the initial relative state (problems/reference.hpp).
+// against the exact orbit of the initial relative state (problems/reference.hpp). run_nbody<true> runs the
+// compensated force (CompensatedNBodyForce: the force's rounding error in double-word) on the inline path.
 #pragma once
 
 #include <algorithm>
@@ -31,9 +32,12 @@ struct NBodyRunResult {
 
 /// `method` is a catalog specification, or GBS or an adaptive method (then `tol` is its tolerance, rtol = atol). h is
 /// in time units: the run is solve() over [0, h steps] in `steps` equal steps (GBS chooses its own). The reference of
-/// nbody is solve() with GBS at ref_tol.
-inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& setup, double h, long steps,
-                                double tol = 0, double ref_tol = 1e-13) {
+/// nbody is solve() with GBS at ref_tol. Compensated: the run with CompensatedNBodyForce (solve_inline(), where the
+/// engines take the force's low parts; #include <nystrom/solve_inline.hpp> to instantiate it), the energy and the
+/// reference as without.
+template <bool Compensated = false>
+NBodyRunResult run_nbody(const std::string& method, const NBodySetup& setup, double h, long steps, double tol = 0,
+                         double ref_tol = 1e-13) {
   if (!(h > 0) || !std::isfinite(h)) throw std::invalid_argument("the step size must be positive");
   if (steps <= 0 || steps > 100000000) throw std::invalid_argument("the number of steps must be between 1 and 1e8");
   const MethodDef def = resolve_solve_method(method);
@@ -55,7 +59,15 @@ inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& set
   }
   NBodyRunResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  const auto sol = solve(prob, def, opt);
+  const auto sol = [&] {
+    if constexpr (Compensated) {
+      CompensatedNBodyForce<double> force(inst.force.masses(), inst.force.eps2());
+      force.threads = inst.force.threads;
+      return solve_inline(SecondOrderProblem(force, s0.q, s0.v, 0.0, span), def, opt);
+    } else {
+      return solve(prob, def, opt);
+    }
+  }();
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.method = def.info.name;
   r.force_evals = sol.force_evals;
@@ -85,5 +97,9 @@ inline NBodyRunResult run_nbody(const std::string& method, const NBodySetup& set
   }
   return r;
 }
+
+/// run_nbody<true>, compiled once in the tool (src/runner_nbody_compensated.cpp).
+NBodyRunResult run_nbody_compensated(const std::string& method, const NBodySetup& setup, double h, long steps,
+                                     double tol);
 
 }  // namespace nystrom

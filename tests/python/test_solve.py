@@ -597,10 +597,68 @@ def test_kepler_compensated_force_goes_below_the_plain_floor():
     assert np.linalg.norm(back.v[-1] * [-1, 1] - vx) < 1.5e-13
 
 
+def test_kepler_compensated_force_takes_fixed_step_splitting_to_the_rounding():
+    # SS10 over t = 640 (about 102 periods) at e = 0.5 with fixed steps whose truncation lies below the rounding of the
+    # result (steps of 2^-8 and 5 2^-10, exact, so that the run ends at 640 exactly): with Kepler(e,
+    # compensated=True) the drifts and kicks run in double-word with the force's rounding error, and the final state
+    # lies within a few 1e-16 of the orbit (double-double reference), where the plain force's rounding leaves about
+    # 1e-13; same force evaluations; backward too.
+    from decimal import Decimal
+
+    t1 = 640.0
+    plain, comp = Kepler(0.5), Kepler(0.5, compensated=True)
+    ref = nystrom.solve(plain, t_span=(0, t1), method="DP12-adaptive", rtol=1e-26, precision="dd", t_eval=[t1])
+    qx = np.array([float(Decimal(x)) for x in ref.q_str])
+    vx = np.array([float(Decimal(x)) for x in ref.v_str])
+    worst, worst_plain = 0.0, 0.0
+    for steps in (131072, 163840):
+        p = nystrom.solve(plain, t_span=(0, t1), method="SS10", steps=steps)
+        c = nystrom.solve(comp, t_span=(0, t1), method="SS10", steps=steps)
+        assert c.force_evals == p.force_evals
+        worst_plain = max(worst_plain, np.linalg.norm(p.q[-1] - qx))
+        worst = max(worst, np.linalg.norm(c.q[-1] - qx), np.linalg.norm(c.v[-1] - vx))
+        back = nystrom.solve(comp, t_span=(0, -t1), method="SS10", steps=steps)
+        worst = max(worst, np.linalg.norm(back.q[-1] * [1, -1] - qx), np.linalg.norm(back.v[-1] * [-1, 1] - vx))
+    assert worst < 1e-15 and worst < 0.1 * worst_plain, (worst, worst_plain)
+
+
+def test_nbody_compensated_force_on_the_two_body_problem():
+    # Two equal masses whose relative orbit is Kepler(0.5) (G (m0 + m1) = 1), over t = 64 (about 10 periods) with SS10
+    # and M8 in 16384 steps (2^-8, exact) whose truncation lies below the rounding: with NBody(compensated=True)
+    # (CompensatedNBodyForce) the relative orbit ends within a few 1e-16 of the double-double reference where the
+    # plain force's rounding leaves more; same force evaluations.
+    from decimal import Decimal
+
+    e, t1 = 0.5, 64.0
+    v0 = math.sqrt((1 - e) / (1 + e))
+
+    def system(compensated):
+        sim = nystrom.problems.NBody(compensated=compensated)
+        sim.add(m=0.5, x=-(1 + e) / 2, vy=-v0 / 2)
+        sim.add(m=0.5, x=(1 + e) / 2, vy=v0 / 2)
+        return sim
+
+    ref = nystrom.solve(Kepler(e), t_span=(0, t1), method="DP12-adaptive", rtol=1e-26, precision="dd", t_eval=[t1])
+    qx = np.array([float(Decimal(x)) for x in ref.q_str])
+    for method, steps in (("SS10", 16384), ("M8", 16384)):
+        p = nystrom.solve(system(False), t_span=(0, t1), method=method, steps=steps)
+        c = nystrom.solve(system(True), t_span=(0, t1), method=method, steps=steps)
+        assert c.force_evals == p.force_evals
+        rel = lambda r: (r.q[-1][1] - r.q[-1][0])[:2]
+        ep, ec = np.linalg.norm(rel(p) - qx), np.linalg.norm(rel(c) - qx)
+        assert ec < 1e-15 and ec < 0.1 * ep, (method, ec, ep)
+    with pytest.raises(ValueError, match="would ignore it"):
+        nystrom.solve(system(True), t_span=(0, 1), method="DP12", steps=10)
+    with pytest.raises(ValueError, match="runs in double precision"):
+        nystrom.solve(system(True), t_span=(0, 1), method="SS10", steps=10, precision="dd")
+    with pytest.raises(TypeError, match="compensated must be True or False"):
+        nystrom.problems.NBody(compensated=1)
+
+
 def test_kepler_compensated_force_refusals():
     comp = Kepler(0.5, compensated=True)
     with pytest.raises(ValueError, match="is used by the adaptive RKN pairs"):
-        nystrom.solve(comp, t_span=(0, 1), method="M8", steps=10)
+        nystrom.solve(comp, t_span=(0, 1), method="DP12", steps=10)
     with pytest.raises(ValueError, match="is used by the adaptive RKN pairs"):
         nystrom.solve(comp, t_span=(0, 1), method="M12-adaptive", rtol=1e-12)
     with pytest.raises(ValueError, match="runs in double precision"):

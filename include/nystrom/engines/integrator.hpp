@@ -70,17 +70,47 @@ class Integrator {
  private:
   using Impl = std::variant<SplittingStepper<V, F>, RknStepper<V, F>, MpeStepper<V, F>>;
 
+  // A scheme normalised in high precision and rounded to the working type, with the coefficients' rounding
+  // residuals: a run with a compensated force takes them (the rounded coefficients bias every step the same way,
+  // below the plain force's rounding but above the compensated force's).
+  static std::pair<SplittingScheme<scalar_type>, std::vector<scalar_type>> rounded_with_residuals(
+      const SplittingScheme<bigcomplex>& scheme) {
+    using S = scalar_type;
+    const auto exact = normalized(scheme);
+    auto rounded = convert_scheme<S>(exact, [](const bigcomplex& x) { return to_scalar<S>(x); });
+    std::vector<S> lo;
+    lo.reserve(exact.steps.size());
+    for (std::size_t i = 0; i < exact.steps.size(); ++i)
+      lo.push_back(to_scalar<S>(exact.steps[i].coef - bigcomplex(bigfloat(rounded.steps[i].coef))));
+    return {std::move(rounded), std::move(lo)};
+  }
+
   static Impl make(const MethodData& data, F force, EngineOptions opt) {
     using S = scalar_type;
     auto conv = [](const bigcomplex& x) { return to_scalar<S>(x); };
-    if (const auto* sp = std::get_if<SplittingScheme<bigcomplex>>(&data))
-      return Impl(std::in_place_index<0>, convert_scheme<S>(*sp, conv), std::move(force), opt);
+    if (const auto* sp = std::get_if<SplittingScheme<bigcomplex>>(&data)) {
+      if constexpr (SplittingStepper<V, F>::carried_force) {
+        auto [rounded, lo] = rounded_with_residuals(*sp);
+        Impl impl(std::in_place_index<0>, std::move(rounded), std::move(force), opt);
+        std::get<0>(impl).set_coefficient_residuals(std::move(lo));
+        return impl;
+      } else {
+        return Impl(std::in_place_index<0>, convert_scheme<S>(*sp, conv), std::move(force), opt);
+      }
+    }
     if (const auto* t = std::get_if<RknTableau<bigcomplex>>(&data))
       return Impl(std::in_place_index<1>, convert_tableau<S>(*t, conv), std::move(force), opt);
     const auto& m = std::get<MpeDef>(data);
     const auto mc = mpe_coefficients(m.k);
-    return Impl(std::in_place_index<2>, m.k, mpe_coefficients_as<S>(mc), convert_scheme<S>(m.base, conv),
-                std::move(force), opt);
+    if constexpr (MpeStepper<V, F>::carried_force) {
+      auto [rounded, lo] = rounded_with_residuals(m.base);
+      Impl impl(std::in_place_index<2>, m.k, mpe_coefficients_as<S>(mc), std::move(rounded), std::move(force), opt);
+      std::get<2>(impl).set_base_coefficient_residuals(std::move(lo));
+      return impl;
+    } else {
+      return Impl(std::in_place_index<2>, m.k, mpe_coefficients_as<S>(mc), convert_scheme<S>(m.base, conv),
+                  std::move(force), opt);
+    }
   }
 
   Impl impl_;

@@ -34,6 +34,7 @@
 #include <omp.h>
 #endif
 
+#include "nystrom/core/eft.hpp"
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/splitting.hpp"
 #include "nystrom/methods/mpe_coefficients.hpp"
@@ -80,8 +81,17 @@ class MpeStepper {
     }
   }
 
+  /// Whether a compensated run also takes the force's rounding error (a compensated force, force(q, cq, a, alo);
+  /// SplittingStepper::carried_force): each product then starts from the state with the run's carries and runs the
+  /// base's compensated drifts and kicks in double-word (SplittingStepper::advance_carried), one product after the
+  /// other.
+  static constexpr bool carried_force = SplittingStepper<V, Force>::carried_force;
+
   /// Whether the products of a step run in lockstep (EngineOptions::mpe_schedule).
   bool lockstep() const { return lockstep_; }
+
+  /// The base's coefficient residuals (SplittingStepper::set_coefficient_residuals).
+  void set_base_coefficient_residuals(std::vector<scalar_type> lo) { base_.set_coefficient_residuals(std::move(lo)); }
 
   long force_evals() const {
     long e = base_.force_evals() + extra_evals_;
@@ -101,6 +111,14 @@ class MpeStepper {
       for (long i = 0; i < n; ++i) naive_step(s, h);
       comp_.invalidate();
       return;
+    }
+    if constexpr (carried_force) {
+      if (use_compensation<scalar_type>(opt_.compensated)) {
+        comp_.begin(s);
+        carried_steps(s, h, n);
+        comp_.end(s);
+        return;
+      }
     }
     // The base's coefficients times h / k_i, product after product (kept while h stays, in the built-in
     // floating-point types: a driver that takes one step per call pays for them once).
@@ -141,6 +159,75 @@ class MpeStepper {
       // All products start with a kick at q_0: evaluate that force once (n(n+1)/2 + 1 for VV).
       base_.force()(s.q, a0_);
       ++extra_evals_;
+    }
+  }
+
+  // n compensated steps with a compensated force (carried_force). Each product starts from s with the run's
+  // carries comp_.cq, comp_.cv (and the force there with its low part, evaluated once when the base starts with a
+  // kick) and runs advance_carried with the base's coefficients times h / k_i as double-words; its increment
+  // (T_i - s) + (carry_i - carry) is then of the size of h v, rounded at eps |h v| instead of eps |q|; the
+  // combination T_ref + sum_{i != ref} c_i (T_i - T_ref) of the increments is added to s and its carry by an exact
+  // two-sum.
+  void carried_steps(State<V>& s, real_type h, long n) requires carried_force {
+    using S = scalar_type;
+    const std::size_t P = k_.size(), m = base_.scheme().steps.size();
+    if (!carried_for_h_ || !(carried_h_ == h)) {
+      carried_.clear();
+      for (std::size_t i = 0; i < P; ++i) {
+        // h / k_i as a double-word: the rounded quotient and the exact remainder over k_i
+        const S k = static_cast<S>(k_[i]), hk = S(h) / k;
+        S e;
+        const S p = eft::two_prod(hk, k, e);
+        base_.scale_coefficients_carried(hk, S(((S(h) - p) - e) / k), carried_);
+      }
+      carried_h_ = h;
+      carried_for_h_ = true;
+    }
+    products_.resize(P);
+    lows_.resize(P);
+    V a0{}, a0lo{}, a{}, alo{}, cq{}, cv{};
+    resize_like(a0, s.q);
+    resize_like(a0lo, s.q);
+    for (long step = 0; step < n; ++step) {
+      if (starts_with_kick_) {
+        base_.force()(s.q, comp_.cq, a0, a0lo);
+        ++extra_evals_;
+      }
+      for (std::size_t i = 0; i < P; ++i) {
+        State<V>& x = products_[i];
+        x = s;
+        a = a0;
+        alo = a0lo;
+        cq = comp_.cq;
+        cv = comp_.cv;
+        bool valid = starts_with_kick_;
+        base_.advance_carried(x, a, alo, valid, carried_.data() + i * m, k_[i], cq, cv);
+        // The increment as a double-word: (x - s) + (carry_i - carry), its high part from an exact two-sum,
+        // kept in x (high) and the product's carries (low).
+        for (std::size_t j = 0; j < s.q.size(); ++j) {
+          S e;
+          x.q[j] = eft::two_sum(x.q[j], S(-s.q[j]), e);
+          cq[j] = e + (cq[j] - comp_.cq[j]);
+          x.v[j] = eft::two_sum(x.v[j], S(-s.v[j]), e);
+          cv[j] = e + (cv[j] - comp_.cv[j]);
+        }
+        lows_[i].q = cq;
+        lows_[i].v = cv;
+      }
+      // T_ref + sum_{i != ref} c_i (T_i - T_ref): the differences of the increments (of the order of the base's
+      // local error) rounded once, the reference increment added as a double-word by an exact two-sum.
+      const State<V>& tref = products_[ref_];
+      const State<V>& lref = lows_[ref_];
+      for (std::size_t j = 0; j < s.q.size(); ++j) {
+        S dq = 0, dv = 0;
+        for (std::size_t i = 0; i < P; ++i) {
+          if (i == ref_) continue;
+          dq += c_[i] * ((products_[i].q[j] - tref.q[j]) + (lows_[i].q[j] - lref.q[j]));
+          dv += c_[i] * ((products_[i].v[j] - tref.v[j]) + (lows_[i].v[j] - lref.v[j]));
+        }
+        eft::add_double_word(s.q[j], comp_.cq[j], tref.q[j], S(lref.q[j] + dq));
+        eft::add_double_word(s.v[j], comp_.cv[j], tref.v[j], S(lref.v[j] + dv));
+      }
     }
   }
 
@@ -427,6 +514,11 @@ class MpeStepper {
   real_type scaled_h_{};                             // the h of scaled_
   bool scaled_for_h_ = false;
   Compensator<V> comp_, pc_;
+  // carried_steps: the base's coefficients times h / k_i as double-words, product after product, for carried_h_
+  std::vector<typename SplittingStepper<V, Force>::Scaled> carried_;
+  std::vector<State<V>> lows_;  // the low parts of the products' increments
+  real_type carried_h_{};
+  bool carried_for_h_ = false;
 };
 
 }  // namespace nystrom

@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "nystrom/core/eft.hpp"
 #include "nystrom/core/state.hpp"
 #include "nystrom/methods/splitting_scheme.hpp"
 
@@ -90,6 +91,12 @@ class SplittingStepper {
   using scalar_type = typename V::value_type;
   using real_type = real_t<scalar_type>;
 
+  /// Whether a compensated run also takes the force's rounding error: with a compensated force, force(q, cq, a, alo)
+  /// (takes_carry_v, core/state.hpp), evaluated at q + cq, the drifts and kicks add the exact products of the
+  /// coefficients (with their residuals, set_coefficient_residuals) and v + cv or a + alo in double-word arithmetic.
+  static constexpr bool carried_force =
+      (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>)&&takes_carry_v<Force, V>;
+
   SplittingStepper(SplittingScheme<scalar_type> scheme, Force force, EngineOptions opt = {})
       : scheme_(normalized(scheme)), force_(std::move(force)), opt_(opt) {
     if (scheme_.steps.empty()) throw std::invalid_argument("splitting scheme has no sub-steps");
@@ -101,6 +108,16 @@ class SplittingStepper {
   }
 
   const SplittingScheme<scalar_type>& scheme() const { return scheme_; }
+  /// The coefficients' rounding residuals (exact minus rounded), one per sub-step of scheme(), used by the
+  /// compensated run with a compensated force (carried_force); without them that run takes the coefficients as
+  /// rounded.
+  void set_coefficient_residuals(std::vector<scalar_type> lo) {
+    if (lo.size() != scheme_.steps.size())
+      throw std::invalid_argument("splitting scheme: one coefficient residual per sub-step is needed");
+    for (const auto& x : lo)
+      if (!is_finite_scalar(x)) throw std::invalid_argument("splitting coefficient residual is not finite");
+    lo_ = std::move(lo);
+  }
   long force_evals() const { return evals_; }
   Force& force() { return force_; }
   /// The compensated-summation carries of the run (checkpoint/restart).
@@ -115,6 +132,7 @@ class SplittingStepper {
     resize_like(aq_, q);
     assign(aq_, q);
     cache_valid_ = true;
+    cache_carried_ = false;
   }
 
   void step(State<V>& s, real_type h) { integrate(s, h, 1); }
@@ -124,7 +142,10 @@ class SplittingStepper {
     if (n <= 0) return;
     if (use_compensation<scalar_type>(opt_.compensated)) {
       comp_.begin(s);
-      run<true>(s, h, n, comp_);
+      if constexpr (carried_force)
+        run_carried(s, h, n, comp_);
+      else
+        run<true>(s, h, n, comp_);
       comp_.end(s);
     } else {
       run<false>(s, h, n, comp_);
@@ -308,6 +329,70 @@ class SplittingStepper {
     evals_ += evals;
   }
 
+  /// A coefficient times the step size as a double-word hi + lo (the compensated run with a compensated force).
+  struct Scaled {
+    scalar_type hi, lo;
+  };
+
+  /// The coefficient c (its rounding residual c_lo) times the step size h + h_lo, as a double-word.
+  static Scaled scaled(const scalar_type& c, const scalar_type& c_lo, const scalar_type& h, const scalar_type& h_lo) {
+    scalar_type e;
+    const scalar_type hi = eft::two_prod(c, h, e);
+    return {hi, scalar_type(e + (c * h_lo + c_lo * h))};
+  }
+
+  /// The coefficients of scheme() with their residuals times h + h_lo (m sub-steps, appended to out).
+  void scale_coefficients_carried(const scalar_type& h, const scalar_type& h_lo, std::vector<Scaled>& out) const {
+    const auto& st = scheme_.steps;
+    for (std::size_t i = 0; i < st.size(); ++i)
+      out.push_back(scaled(st[i].coef, lo_.empty() ? scalar_type(0) : lo_[i], h, h_lo));
+  }
+
+  /// The compensated run with a compensated force (carried_force) on a state x, force cache a + alo (valid: it is
+  /// the force at x.q + cq; updated) and carries cq, cv held by the caller: n steps with the scaled coefficients
+  /// hcw (scale_coefficients_carried, m sub-steps). The position q + cq goes to the force, which returns a + alo; a
+  /// drift adds c h (v + cv) and a kick c h (a + alo) to the double-word q + cq or v + cv, each product c h v and
+  /// c h a exact. Only the force's own rounding (about eps^2 for a compensated force) and the double-word sums'
+  /// (about eps^2) are left, so that a long run's error stays at the rounding of its double result where the plain
+  /// force's rounding would set a floor about sqrt(force evaluations) times higher. The force evaluations are
+  /// counted; the stepper's own cache is not touched. The results do not depend on how the steps are split into
+  /// calls.
+  void advance_carried(State<V>& x, V& a, V& alo, bool& valid, const Scaled* hcw, long n, V& cq,
+                       V& cv) requires carried_force {
+    using eft::add_double_word;
+    using eft::two_prod;
+    using S = scalar_type;
+    if (n <= 0) return;
+    const auto& st = scheme_.steps;
+    const std::size_t m = st.size();
+    long evals = 0;
+    auto drift = [&](const Scaled& k, std::size_t) NYSTROM_ALWAYS_INLINE {
+      for (std::size_t j = 0; j < x.q.size(); ++j) {
+        S e;
+        const S p = two_prod(k.hi, x.v[j], e);
+        add_double_word(x.q[j], cq[j], p, S(e + (k.hi * cv[j] + k.lo * x.v[j])));
+      }
+      valid = false;
+    };
+    auto kick = [&](const Scaled& k, std::size_t) NYSTROM_ALWAYS_INLINE {
+      if (!valid) {
+        force_(x.q, cq, a, alo);
+        ++evals;
+        valid = true;
+      }
+      for (std::size_t j = 0; j < x.v.size(); ++j) {
+        S e;
+        const S p = two_prod(k.hi, a[j], e);
+        add_double_word(x.v[j], cv[j], p, S(e + (k.hi * alo[j] + k.lo * a[j])));
+      }
+    };
+    // Sub-step by sub-step, also where the last sub-step of a step and the first of the next are of the same flow:
+    // joined into one, their double-word sum would round differently at the ends of a call, and a run split into
+    // several calls would not be bitwise one call (the extra sub-step costs no force evaluation).
+    run_sequential_splitting(flows_.data(), hcw, m, n, drift, kick, [] {});
+    evals_ += evals;
+  }
+
  private:
   /// Sub-steps one after the other: schemes whose steps do not merge, and complex schemes whose state is
   /// projected to real after every step (the arguments as for advance_scaled).
@@ -385,7 +470,44 @@ class SplittingStepper {
       }
     }
     cache_valid_ = valid;
+    cache_carried_ = false;
     remember(s.q);
+  }
+
+  // The compensated run with a compensated force (advance_carried) on the stepper's own cache.
+  void run_carried(State<V>& s, real_type h, long n, Compensator<V>& c) {
+    resize_like(a_, s.q);
+    resize_like(alo_, s.q);
+    check_cache(s.q);
+    if (cache_valid_ && !(cache_carried_ && same_values(acq_, c.cq))) cache_valid_ = false;
+    hcw_.clear();
+    scale_coefficients_carried(scalar_type(h), scalar_type(0), hcw_);
+    constexpr bool local = is_std_array<V>::value;  // see run()
+    std::conditional_t<local, State<V>, State<V>&> x = s;
+    std::conditional_t<local, V, V&> a = a_, alo = alo_, cq = c.cq, cv = c.cv;
+    bool valid = cache_valid_;
+    advance_carried(x, a, alo, valid, hcw_.data(), n, cq, cv);
+    if constexpr (local) {
+      s = x;
+      a_ = a;
+      alo_ = alo;
+      c.cq = cq;
+      c.cv = cv;
+    }
+    cache_valid_ = valid;
+    cache_carried_ = valid;
+    remember(s.q);
+    if (valid) {
+      resize_like(acq_, c.cq);
+      assign(acq_, c.cq);
+    }
+  }
+
+  static bool same_values(const V& x, const V& y) {
+    if (x.size() != y.size()) return false;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (!(x[i] == y[i])) return false;
+    return true;
   }
 
   // The cache survives between calls only if the caller did not move q.
@@ -420,6 +542,13 @@ class SplittingStepper {
   bool cache_valid_ = false;
   long evals_ = 0;
   std::vector<scalar_type> hc_;
+  // The compensated run with a compensated force: the coefficients' residuals, the scaled coefficients, the force's
+  // low part and the carry of the position it was evaluated at (the cache holds a + alo at aq_ + acq_).
+  std::vector<scalar_type> lo_;
+  std::vector<Scaled> hcw_;
+  V alo_{};
+  V acq_{};
+  bool cache_carried_ = false;
 };
 
 }  // namespace nystrom

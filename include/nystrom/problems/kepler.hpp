@@ -53,30 +53,15 @@ struct CompensatedKeplerForce : KeplerForce {
     using eft::fast_two_sum;
     using eft::two_prod;
     using eft::two_sum;
-    using std::sqrt;
     // r^2 = |q + cq|^2 = r2 + r2l
     S e0, e1, e2;
     const S x2 = two_prod(q[0], q[0], e0), y2 = two_prod(q[1], q[1], e1);
     const S s = two_sum(x2, y2, e2);
     S r2l;
     const S r2 = fast_two_sum(s, (e0 + e1 + e2) + S(2) * (q[0] * cq[0] + q[1] * cq[1]), r2l);
-    // m0 = 1 / (r2 r0), r0 the rounded square root: the one division, a few ulps from 1 / r^3
-    const S r0 = sqrt(r2);
-    const S m0 = S(1) / (r2 * r0);
-    // r = sqrt(r^2) = r1 + r1l: one Newton correction of r0, the division by 2 r0 as a product with r2 m0 ~ 1 / r0
-    S er;
-    const S sq = two_prod(r0, r0, er);
-    S r1l;
-    const S r1 = fast_two_sum(r0, (((r2 - sq) - er) + r2l) * (S(0.5) * r2 * m0), r1l);
-    // r^3 = r^2 r = r3 + r3l
-    S ep;
-    const S p = two_prod(r2, r1, ep);
-    S r3l;
-    const S r3 = fast_two_sum(p, ep + (r2 * r1l + r2l * r1), r3l);
-    // m = 1 / r^3 = m0 + ml: one Newton correction of m0
-    S em;
-    const S pm = two_prod(m0, r3, em);
-    const S ml = m0 * (((S(1) - pm) - em) - m0 * r3l);
+    // m = 1 / r^3 = m0 + ml
+    S ml;
+    const S m0 = eft::dw_inv_r3(r2, r2l, ml);
     // a = -(q + cq) m
     for (std::size_t k = 0; k < 2; ++k) {
       S e;

@@ -182,6 +182,10 @@ struct ErasedProblem {
 template <class V, class F>
 ErasedProblem<typename V::value_type> erase(const SecondOrderProblem<V, F>& p) {
   using T = typename V::value_type;
+  static_assert(!takes_carry_v<F, V>,
+                "a compensated force, force(q, cq, a, alo), runs on the inline path, where the engines use its low "
+                "parts: #include <nystrom/solve_inline.hpp> and call solve_inline() (the compiled drivers call "
+                "force(q, a) only)");
   return {ErasedForce<T>(p.force), std::vector<T>(p.q0.begin(), p.q0.end()), std::vector<T>(p.v0.begin(), p.v0.end()),
           p.t0, p.t1};
 }
