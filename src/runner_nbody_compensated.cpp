@@ -7,7 +7,7 @@ namespace nystrom {
 
 NBodyRunResult run_nbody_compensated(const std::string& method, const NBodySetup& setup, double h, long steps,
                                      double tol) {
-  return run_nbody<true>(method, setup, h, steps, tol);
+  return run_nbody<CompensatedNBodyForce<double>>(method, setup, h, steps, tol);
 }
 
 }  // namespace nystrom

@@ -2,14 +2,16 @@
 // solve(): `steps` steps of size h with a catalog method (real or complex coefficients), or GBS at a
 // tolerance (method "GBS"), and report the relative energy error and the position error against a GBS
 // reference run of the same length (tolerance ref_tol). For twobody the position error is also measured
-// against the exact orbit of the initial relative state (problems/reference.hpp). run_nbody<true> runs the
-// compensated force (CompensatedNBodyForce: the force's rounding error in double-word) on the inline path.
+// against the exact orbit of the initial relative state (problems/reference.hpp).
+// run_nbody<CompensatedNBodyForce<double>> runs the compensated force (the force's rounding error in double-word),
+// which solve() runs on the inline path.
 #pragma once
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "localerr.hpp"
 #include "nystrom/methods/catalog.hpp"
@@ -32,10 +34,10 @@ struct NBodyRunResult {
 
 /// `method` is a catalog specification, or GBS or an adaptive method (then `tol` is its tolerance, rtol = atol). h is
 /// in time units: the run is solve() over [0, h steps] in `steps` equal steps (GBS chooses its own). The reference of
-/// nbody is solve() with GBS at ref_tol. Compensated: the run with CompensatedNBodyForce (solve_inline(), where the
-/// engines take the force's low parts; #include <nystrom/solve_inline.hpp> to instantiate it), the energy and the
-/// reference as without.
-template <bool Compensated = false>
+/// nbody is solve() with GBS at ref_tol. Force: another force type built from the masses and the softening (with
+/// CompensatedNBodyForce solve() runs the inline path, where the engines take the force's low parts: instantiate it
+/// where nystrom/solve_inline.hpp is included); the energy and the reference as with NBodyForce.
+template <class Force = NBodyForce<double>>
 NBodyRunResult run_nbody(const std::string& method, const NBodySetup& setup, double h, long steps, double tol = 0,
                          double ref_tol = 1e-13) {
   if (!(h > 0) || !std::isfinite(h)) throw std::invalid_argument("the step size must be positive");
@@ -60,12 +62,12 @@ NBodyRunResult run_nbody(const std::string& method, const NBodySetup& setup, dou
   NBodyRunResult r;
   const auto t0 = std::chrono::steady_clock::now();
   const auto sol = [&] {
-    if constexpr (Compensated) {
-      CompensatedNBodyForce<double> force(inst.force.masses(), inst.force.eps2());
-      force.threads = inst.force.threads;
-      return solve_inline(SecondOrderProblem(force, s0.q, s0.v, 0.0, span), def, opt);
-    } else {
+    if constexpr (std::is_same_v<Force, NBodyForce<double>>) {
       return solve(prob, def, opt);
+    } else {
+      Force force(inst.force.masses(), inst.force.eps2());
+      force.threads = inst.force.threads;
+      return solve(SecondOrderProblem(force, s0.q, s0.v, 0.0, span), def, opt);
     }
   }();
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -98,7 +100,7 @@ NBodyRunResult run_nbody(const std::string& method, const NBodySetup& setup, dou
   return r;
 }
 
-/// run_nbody<true>, compiled once in the tool (src/runner_nbody_compensated.cpp).
+/// run_nbody<CompensatedNBodyForce<double>>, compiled once in the tool (src/runner_nbody_compensated.cpp).
 NBodyRunResult run_nbody_compensated(const std::string& method, const NBodySetup& setup, double h, long steps,
                                      double tol);
 
