@@ -280,6 +280,28 @@ SecondOrderProblem<V, CompensatedKeplerForce> compensated_kepler(double ecc, dou
   return SecondOrderProblem(CompensatedKeplerForce{}, s0.q, s0.v, 0.0, t1);
 }
 
+// The run of prob (span [0, t1]) with opt, and the same run checkpointed at 0.41 t1 and resumed: both end bitwise
+// where the first does, with the same step count. Returns the uninterrupted run.
+Solution<V> expect_restart_is_bitwise(const SecondOrderProblem<V, CompensatedKeplerForce>& prob, const MethodDef& def,
+                                      SolveOptions opt, double t1) {
+  const auto plain = solve(prob, def, opt);
+  EXPECT_EQ(plain.status, SolveStatus::success);
+  opt.checkpoint_at = 0.41 * t1;
+  opt.checkpoint_problem = "kepler compensated";
+  std::string text;
+  opt.on_checkpoint = [&](const std::string& s) { text = s; };
+  const auto first = solve(prob, def, opt);
+  EXPECT_TRUE(first.checkpoint.has_value());
+  EXPECT_EQ(first.q_final, plain.q_final);
+  EXPECT_EQ(first.v_final, plain.v_final);
+  const auto second = resume(prob, def, checkpoint_from_text<double>(text), opt);
+  EXPECT_EQ(second.q_final, plain.q_final);
+  EXPECT_EQ(second.v_final, plain.v_final);
+  EXPECT_EQ(second.accepted, plain.accepted);
+  EXPECT_EQ(second.rejected, plain.rejected);
+  return plain;
+}
+
 }  // namespace
 
 // With the compensated force the precise update of DP12-adaptive takes the force's rounding error, the exact
@@ -321,24 +343,9 @@ TEST(Compensated, CompensatedForceRunRestartsBitwiseBothDirections) {
   const auto def = resolve_solve_method("DP12-adaptive");
   for (double t1 : {30.0, -30.0}) {
     SCOPED_TRACE(t1);
-    const auto prob = compensated_kepler(0.7, t1);
     SolveOptions opt;
     opt.rtol = 1e-15;
-    const auto plain = solve(prob, def, opt);
-    ASSERT_EQ(plain.status, SolveStatus::success);
-    opt.checkpoint_at = 0.41 * t1;
-    opt.checkpoint_problem = "kepler e=0.7 compensated";
-    std::string text;
-    opt.on_checkpoint = [&](const std::string& s) { text = s; };
-    const auto first = solve(prob, def, opt);
-    ASSERT_TRUE(first.checkpoint.has_value());
-    EXPECT_EQ(first.q_final, plain.q_final);
-    EXPECT_EQ(first.v_final, plain.v_final);
-    const auto second = resume(prob, def, checkpoint_from_text<double>(text), opt);
-    EXPECT_EQ(second.q_final, plain.q_final);
-    EXPECT_EQ(second.v_final, plain.v_final);
-    EXPECT_EQ(second.accepted, plain.accepted);
-    EXPECT_EQ(second.rejected, plain.rejected);
+    const auto plain = expect_restart_is_bitwise(compensated_kepler(0.7, t1), def, opt, t1);
     // The force is counted like any other (16 stages, first same as last).
     EXPECT_GE(plain.force_evals, 15 * plain.accepted);
     // And it is the orbit: against the exact one of the run's initial state at |t1| = 30.
@@ -539,23 +546,9 @@ TEST(Compensated, CompensatedForceFixedStepRunRestartsBitwise) {
   for (const char* method : {"SS10", "M8", "VV"}) {
     for (double t1 : {20.0, -20.0}) {
       SCOPED_TRACE(std::string(method) + " " + std::to_string(t1));
-      const auto def = resolve_solve_method(method);
-      const auto prob = compensated_kepler(0.7, t1);
       SolveOptions opt;
       opt.steps = 3001;
-      const auto plain = solve(prob, def, opt);
-      ASSERT_EQ(plain.status, SolveStatus::success);
-      opt.checkpoint_at = 0.41 * t1;
-      opt.checkpoint_problem = "kepler e=0.7 compensated";
-      std::string text;
-      opt.on_checkpoint = [&](const std::string& s) { text = s; };
-      const auto first = solve(prob, def, opt);
-      ASSERT_TRUE(first.checkpoint.has_value());
-      EXPECT_EQ(first.q_final, plain.q_final);
-      const auto second = resume(prob, def, checkpoint_from_text<double>(text), opt);
-      EXPECT_EQ(second.q_final, plain.q_final);
-      EXPECT_EQ(second.v_final, plain.v_final);
-      EXPECT_EQ(second.accepted, plain.accepted);
+      expect_restart_is_bitwise(compensated_kepler(0.7, t1), resolve_solve_method(method), opt, t1);
     }
   }
 }

@@ -22,6 +22,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -169,6 +170,31 @@ TEST(AdaptiveFloorCli, CompensatedForceIsRefusedWhereNothingUsesIt) {
   EXPECT_NE(r.err.find("eps / 2 with a compensated force"), std::string::npos) << r.err;
 }
 
+namespace {
+
+// The largest position error `run PROBLEM_ARGS --steps-per-period N --json` reports over the step counts spp with the
+// compensated force, and with the plain force ({compensated, plain}); both runs name their force and evaluate it
+// equally often.
+std::pair<double, double> largest_errors(const std::string& problem_args, const std::vector<long>& spp) {
+  double worst = 0, worst_plain = 0;
+  for (long n : spp) {
+    const std::string args = "run " + problem_args + " --steps-per-period " + std::to_string(n) + " --json";
+    const auto p = run(args), q = run(args + " --force compensated");
+    EXPECT_EQ(p.code, 0) << p.err;
+    EXPECT_EQ(q.code, 0) << q.err;
+    if (p.code != 0 || q.code != 0) return {1, 1};
+    const auto jp = nlohmann::json::parse(p.out), jq = nlohmann::json::parse(q.out);
+    EXPECT_EQ(jq.at("force").get<std::string>(), "compensated");
+    EXPECT_EQ(jp.at("force").get<std::string>(), "plain");
+    EXPECT_EQ(jq.at("force_evals").get<long>(), jp.at("force_evals").get<long>());
+    worst = std::max(worst, jq.at("position_error").get<double>());
+    worst_plain = std::max(worst_plain, jp.at("position_error").get<double>());
+  }
+  return {worst, worst_plain};
+}
+
+}  // namespace
+
 // The fixed-step methods with the compensated force (--force compensated: compensated drifts and kicks in
 // double-word with the force's rounding error, engines/splitting.hpp; the multi-product increments as double-words,
 // engines/mpe.hpp): at step counts whose truncation lies below the double result's rounding, the largest reported
@@ -183,19 +209,8 @@ TEST(AdaptiveFloorCli, FixedStepMethodsWithTheCompensatedForce) {
   for (const Case& c : {Case{"SS10", 0.5, {1131, 1345, 1600, 1903}}, Case{"SS10", 0.9, {2691, 3200, 3805, 4525}},
                         Case{"KL8", 0.5, {1131, 1345, 1600, 1903}}, Case{"KL8", 0.9, {5382, 6400, 7611, 9051}},
                         Case{"M8", 0.5, {1131, 1345, 1600, 1903}}, Case{"M8", 0.9, {12800, 15222, 18102, 21527}}}) {
-    double worst = 0, worst_plain = 0;
-    for (long spp : c.spp) {
-      const std::string args = "run --problem kepler --periods 100 --ecc " + tol_text(c.ecc) + " --method " + c.method +
-                               " --steps-per-period " + std::to_string(spp) + " --json";
-      const auto p = run(args), q = run(args + " --force compensated");
-      ASSERT_EQ(p.code, 0) << p.err;
-      ASSERT_EQ(q.code, 0) << q.err;
-      const auto jp = nlohmann::json::parse(p.out), jq = nlohmann::json::parse(q.out);
-      EXPECT_EQ(jq.at("force").get<std::string>(), "compensated");
-      EXPECT_EQ(jq.at("force_evals").get<long>(), jp.at("force_evals").get<long>());
-      worst = std::max(worst, jq.at("position_error").get<double>());
-      worst_plain = std::max(worst_plain, jp.at("position_error").get<double>());
-    }
+    const auto [worst, worst_plain] =
+        largest_errors("--problem kepler --periods 100 --ecc " + tol_text(c.ecc) + " --method " + c.method, c.spp);
     std::printf("[ floor ] %s --force compensated e %.1f: largest error %.3e over four step sizes (plain force %.3e)\n",
                 c.method, c.ecc, worst, worst_plain);
     EXPECT_LE(worst, c.ecc < 0.7 ? 3e-14 : 1e-13) << c.method << " e " << c.ecc;
@@ -209,20 +224,8 @@ TEST(AdaptiveFloorCli, FixedStepMethodsWithTheCompensatedForce) {
 // force evaluations; the JSON names the force.
 TEST(AdaptiveFloorCli, TwoBodyWithTheCompensatedNBodyForce) {
   for (const char* method : {"SS10", "M8"}) {
-    double worst = 0, worst_plain = 0;
-    for (long spp : {951L, 1131L, 1345L}) {
-      const std::string args = std::string("run --problem twobody --ecc 0.5 --periods 10 --method ") + method +
-                               " --steps-per-period " + std::to_string(spp) + " --json";
-      const auto p = run(args), q = run(args + " --force compensated");
-      ASSERT_EQ(p.code, 0) << p.err;
-      ASSERT_EQ(q.code, 0) << q.err;
-      const auto jp = nlohmann::json::parse(p.out), jq = nlohmann::json::parse(q.out);
-      EXPECT_EQ(jq.at("force").get<std::string>(), "compensated");
-      EXPECT_EQ(jp.at("force").get<std::string>(), "plain");
-      EXPECT_EQ(jq.at("force_evals").get<long>(), jp.at("force_evals").get<long>());
-      worst = std::max(worst, jq.at("position_error").get<double>());
-      worst_plain = std::max(worst_plain, jp.at("position_error").get<double>());
-    }
+    const auto [worst, worst_plain] =
+        largest_errors(std::string("--problem twobody --ecc 0.5 --periods 10 --method ") + method, {951, 1131, 1345});
     std::printf("[ floor ] twobody %s --force compensated: largest error %.3e (plain force %.3e)\n", method, worst,
                 worst_plain);
     EXPECT_LE(worst, 3e-16) << method;

@@ -81,7 +81,9 @@ inline constexpr bool takes_velocity_v =
 
 /// Whether a force is also compensated, force(q, cq, a, alo) besides force(q, a): it takes the position q + cq (cq
 /// the carry of compensated summation) and returns the acceleration a + alo to about twice the working precision.
-/// The precise update of the adaptive RKN pairs (engines/rkn.hpp) uses it; every other engine calls force(q, a).
+/// The compensated runs of the adaptive RKN pairs (engines/rkn.hpp) and of the fixed-step splitting and multi-product
+/// engines (engines/splitting.hpp, engines/mpe.hpp) use it in double and float; the other engines call force(q, a),
+/// and solve() runs such a force on the inline path (solve.hpp).
 template <class F, class V>
 inline constexpr bool takes_carry_v =
     std::conjunction_v<std::is_invocable<F&, const V&, const V&, V&, V&>, std::is_invocable<F&, const V&, V&>>;

@@ -44,7 +44,8 @@ struct KeplerForce {
 /// compensated force(q, cq, a, alo) takes the position q + cq (cq its carry) and returns -(q + cq) / |q + cq|^3 as
 /// a + alo, in double-word arithmetic from error-free transformations (core/eft.hpp; Dekker, Numer. Math. 18 (1971)
 /// 224): relative error a few units of the working precision squared, where force(q, a) rounds at a few units of
-/// it. The precise update of the adaptive RKN pairs uses it (engines/rkn.hpp, takes_carry_v).
+/// it. The precise update of the adaptive RKN pairs and the compensated fixed-step splitting and multi-product runs use
+/// it (engines/rkn.hpp, engines/splitting.hpp, engines/mpe.hpp; takes_carry_v).
 struct CompensatedKeplerForce : KeplerForce {
   using KeplerForce::operator();
   template <class V, class S = typename V::value_type>
