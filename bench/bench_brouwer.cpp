@@ -8,9 +8,11 @@
 // times the period exactly in the reference; adaptive: integrate_to the output times, which are step ends). At
 // log-spaced numbers of periods the program prints the relative energy error and the position error against the
 // exact orbit of the rounded initial state (problems/reference.hpp, in quad-double), and at the end the slopes of
-// log error against log t fitted over the last three decades (Brouwer: 0.5 and 1.5).
+// log error against log t fitted over the last three decades (Brouwer: 0.5 and 1.5). SS10 and KL8 run a second time
+// with the compensated Kepler force (CompensatedKeplerForce: drifts and kicks in double-word with the force's
+// rounding error, engines/splitting.hpp), whose rounding per step is about eps^2 instead of eps.
 //
-//   bench_brouwer [--periods N (1e6)] [--ecc E (0.5)] [--csv FILE]
+//   bench_brouwer [--periods N (1e6)] [--ecc E (0.5)] [--csv FILE] [--compensated-only]
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -41,6 +43,7 @@ struct Config {
   std::string method;
   long steps_per_period;  // 0: adaptive
   double tol;
+  bool compensated = false;  // CompensatedKeplerForce: the force's rounding error in double-word
 };
 
 std::string fmt_tol(double tol) {
@@ -65,6 +68,7 @@ double slope(const std::vector<Point>& pts, double x_min, bool energy) {
   return n > 1 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : 0;
 }
 
+template <class Force>
 std::vector<Point> run(const Config& c, double ecc, long periods, long& forces, double& seconds) {
   const KeplerProblem<double> kp(ecc);
   const State<V> s0 = kp.initial_state();
@@ -83,19 +87,24 @@ std::vector<Point> run(const Config& c, double ecc, long periods, long& forces, 
     for (long f : {1L, 2L, 5L})
       if (f * d <= periods) outs.push_back(f * d);
   if (c.steps_per_period > 0) {
-    auto integ = make_integrator<V>(def, KeplerForce{});
+    auto integ = make_integrator<V>(def, Force{});
     const double h = period / static_cast<double>(c.steps_per_period);
     for (long m : outs) {
       integ.integrate(s, h, (m - done) * c.steps_per_period);
       done = m;
-      record(m, kepler_reference_errors(s0, s, h, m * c.steps_per_period));
+      State<V> x = s;  // with the carries of compensated summation
+      for (std::size_t i = 0; i < 2; ++i) {
+        x.q[i] += integ.compensator().cq[i];
+        x.v[i] += integ.compensator().cv[i];
+      }
+      record(m, kepler_reference_errors(s0, x, h, m * c.steps_per_period));
     }
     forces = integ.force_evals();
   } else {
     AdaptiveOptions opt;
     opt.rtol = c.tol;
     opt.max_steps = 4000000000L;  // a call may span 5e5 periods
-    auto integ = make_adaptive_integrator<V>(def, KeplerForce{}, opt);
+    auto integ = make_adaptive_integrator<V>(def, Force{}, opt);
     double t = 0;
     forces = 0;
     for (long m : outs) {
@@ -115,6 +124,7 @@ int main(int argc, char** argv) {
   long periods = 1000000;
   double ecc = 0.5;
   std::string csv;
+  bool compensated_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--periods" && i + 1 < argc) {
@@ -123,8 +133,10 @@ int main(int argc, char** argv) {
       ecc = std::atof(argv[++i]);
     } else if (a == "--csv" && i + 1 < argc) {
       csv = argv[++i];
+    } else if (a == "--compensated-only") {
+      compensated_only = true;
     } else {
-      std::fprintf(stderr, "usage: bench_brouwer [--periods N] [--ecc E] [--csv FILE]\n");
+      std::fprintf(stderr, "usage: bench_brouwer [--periods N] [--ecc E] [--csv FILE] [--compensated-only]\n");
       return 2;
     }
   }
@@ -132,22 +144,30 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_brouwer: --periods must lie in 1..1e8 and --ecc in [0, 1)\n");
     return 2;
   }
-  const std::vector<Config> configs = {{"SS10", 200, 0},
-                                       {"KL8", 500, 0},
-                                       {"DP12", 200, 0},
-                                       {"DP12-adaptive", 0, 2.5e-15},
-                                       {"DOP853-adaptive", 0, 3e-15}};
+  std::vector<Config> configs = {{"SS10", 200, 0},
+                                 {"KL8", 500, 0},
+                                 {"DP12", 200, 0},
+                                 {"DP12-adaptive", 0, 2.5e-15},
+                                 {"DOP853-adaptive", 0, 3e-15},
+                                 {"SS10", 200, 0, true},
+                                 {"KL8", 500, 0, true}};
+  if (compensated_only) std::erase_if(configs, [](const Config& c) { return !c.compensated; });
   std::ofstream out;
   if (!csv.empty()) {
     out.open(csv + ".tmp");
     out << "method,steps_per_period,tol,periods,energy_error,position_error\n";
   }
-  std::printf("Kepler e = %g, %ld periods, double, compensated (defaults)\n", ecc, periods);
+  std::printf(
+      "Kepler e = %g, %ld periods, double, compensated summation (the default); the plain force, or the "
+      "compensated one where marked\n",
+      ecc, periods);
   for (const auto& c : configs) {
     long forces = 0;
     double seconds = 0;
-    const auto pts = run(c, ecc, periods, forces, seconds);
-    std::printf("\n%s %s: %ld forces, %.1f s\n  %10s %12s %12s\n", c.method.c_str(),
+    const auto pts = c.compensated ? run<CompensatedKeplerForce>(c, ecc, periods, forces, seconds)
+                                   : run<KeplerForce>(c, ecc, periods, forces, seconds);
+    const std::string label = c.method + (c.compensated ? " (compensated force)" : "");
+    std::printf("\n%s %s: %ld forces, %.1f s\n  %10s %12s %12s\n", label.c_str(),
                 c.steps_per_period > 0 ? (std::to_string(c.steps_per_period) + " steps/period").c_str()
                                        : ("tol " + fmt_tol(c.tol)).c_str(),
                 forces, seconds, "periods", "energy", "position");
@@ -155,7 +175,7 @@ int main(int argc, char** argv) {
     for (const auto& p : pts) {
       std::printf("  %10.0f %12.3e %12.3e\n", p.periods, p.energy, p.position);
       if (out)
-        out << c.method << ',' << c.steps_per_period << ',' << c.tol << ',' << p.periods << ',' << p.energy << ','
+        out << label << ',' << c.steps_per_period << ',' << c.tol << ',' << p.periods << ',' << p.energy << ','
             << p.position << '\n';
     }
     const double from = std::max(1.0, static_cast<double>(periods) / 1000);
