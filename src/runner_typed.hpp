@@ -116,10 +116,10 @@ OrbitRun<T, N> run_orbit_with(const RunRequest& req, const MethodDef& def,
 
 template <class T, std::size_t N>
 OrbitRun<T, N> run_orbit(const RunRequest& req, const MethodDef& def, const RunOutputs<std::array<T, N>>& outputs) {
+  // check_run_request (every caller's first step) admits --force compensated only for kepler in double.
   if constexpr (N == 2 && std::is_same_v<T, double>) {
     if (req.force == "compensated") return run_orbit_with<T, N, CompensatedKeplerForce>(req, def, outputs);
   }
-  if (req.force != "plain") throw UsageError("--force compensated runs the kepler problem in double precision");
   return run_orbit_with<T, N, std::conditional_t<N == 2, KeplerForce, HarmonicForce>>(req, def, outputs);
 }
 

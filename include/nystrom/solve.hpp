@@ -36,6 +36,11 @@
 
 namespace nystrom {
 
+/// Whether solve() and resume() run a problem with state V and force F on the drivers compiled in libnystrom (the
+/// states of is_compiled_state, a force without the compensated form) rather than on the inline path.
+template <class V, class F>
+inline constexpr bool runs_compiled_v = is_compiled_state<V>::value && !takes_carry_v<F, V>;
+
 /// Integrates `problem` with `method` (a catalog entry or specification, see methods/catalog.hpp) and
 /// returns the solution. Throws invalid_input for a problem, method or options that cannot be integrated,
 /// step_size_underflow / too_many_steps when an adaptive run cannot go on, nystrom::error when the state
@@ -43,7 +48,7 @@ namespace nystrom {
 template <class V, class F>
 Solution<V> solve(const SecondOrderProblem<V, F>& problem, const std::string& method, const SolveOptions& options = {},
                   const std::vector<Event<V>>& events = {}) {
-  if constexpr (is_compiled_state<V>::value && !takes_carry_v<F, V>) {
+  if constexpr (runs_compiled_v<V, F>) {
     return compiled::solve<typename V::value_type>(erase(problem), nullptr, method, options, events, nullptr);
   } else {
     return solve_inline(problem, method, options, events);  // std::array etc.: #include <nystrom/solve_inline.hpp>
@@ -54,7 +59,7 @@ Solution<V> solve(const SecondOrderProblem<V, F>& problem, const std::string& me
 template <class V, class F>
 Solution<V> solve(const SecondOrderProblem<V, F>& problem, const MethodDef& method, const SolveOptions& options = {},
                   const std::vector<Event<V>>& events = {}) {
-  if constexpr (is_compiled_state<V>::value && !takes_carry_v<F, V>) {
+  if constexpr (runs_compiled_v<V, F>) {
     return compiled::solve<typename V::value_type>(erase(problem), &method, std::string(), options, events, nullptr);
   } else {
     return solve_inline(problem, method, options, events);  // std::array etc.: #include <nystrom/solve_inline.hpp>
@@ -68,7 +73,7 @@ template <class V, class F>
 Solution<V> resume(const SecondOrderProblem<V, F>& problem, const MethodDef& method,
                    const Checkpoint<real_t<typename V::value_type>>& from, const SolveOptions& options = {},
                    const std::vector<Event<V>>& events = {}) {
-  if constexpr (is_compiled_state<V>::value && !takes_carry_v<F, V>) {
+  if constexpr (runs_compiled_v<V, F>) {
     return compiled::solve<typename V::value_type>(erase(problem), &method, std::string(), options, events, &from);
   } else {
     return resume_inline(problem, method, from, options, events);  // std::array: #include <nystrom/solve_inline.hpp>
@@ -79,7 +84,7 @@ template <class V, class F>
 Solution<V> resume(const SecondOrderProblem<V, F>& problem, const std::string& method,
                    const Checkpoint<real_t<typename V::value_type>>& from, const SolveOptions& options = {},
                    const std::vector<Event<V>>& events = {}) {
-  if constexpr (is_compiled_state<V>::value && !takes_carry_v<F, V>) {
+  if constexpr (runs_compiled_v<V, F>) {
     return compiled::solve<typename V::value_type>(erase(problem), nullptr, method, options, events, &from);
   } else {
     return resume_inline(problem, method, from, options, events);  // std::array: #include <nystrom/solve_inline.hpp>

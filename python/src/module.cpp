@@ -341,7 +341,7 @@ PYBIND11_MODULE(_core, m) {
           return solve_python_force(std::move(force), std::move(shape), r, velocity);
         }
         if (precision == "double") return solve_builtin_double(problem, params, r);
-        if (problem == "kepler_compensated" || problem == "nbody_compensated")
+        if (is_compensated_problem(problem))
           throw invalid_input("compensated=True runs in double precision, not '" + precision + "'");
         return solve_builtin_extended(problem, params, r, precision);
       },

@@ -361,8 +361,13 @@ struct SmallProblemForce {
 /// A Python force(t, q) in double (real and complex coefficients), or force(t, q, v) when `velocity`.
 py::dict solve_python_force(py::object force, std::vector<py::ssize_t> shape, const SolveRequest& r,
                             bool velocity = false);
+/// Whether a built-in problem runs its compensated force (Kepler(e, compensated=True), NBody(..., compensated=True)):
+/// in double only, for the methods that take it (methods/compensated_force.hpp).
+inline bool is_compensated_problem(const std::string& problem) {
+  return problem == "kepler_compensated" || problem == "nbody_compensated";
+}
 /// A built-in problem in double: "kepler", "henon_heiles", "harmonic" (params: omega^2), "nbody" (params:
-/// eps^2, then G m_i; the structure-of-arrays layout of nbody.hpp).
+/// eps^2, then G m_i; the structure-of-arrays layout of nbody.hpp), and "kepler_compensated", "nbody_compensated".
 py::dict solve_builtin_double(const std::string& problem, const std::vector<double>& params, const SolveRequest& r);
 /// "kepler", "henon_heiles" or "harmonic" in an extended precision (long-double, float128, dd, qd, mpfr:BITS).
 py::dict solve_builtin_extended(const std::string& problem, const std::vector<double>& params, const SolveRequest& r,

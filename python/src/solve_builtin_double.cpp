@@ -11,23 +11,17 @@
 namespace nystrom::python {
 
 py::dict solve_builtin_double(const std::string& problem, const std::vector<double>& params, const SolveRequest& r) {
+  // Kepler(e, compensated=True), NBody(..., compensated=True): the force in double-word, for the methods that take
+  // it, with the refusal of the tool's `run --force compensated`.
+  if (is_compensated_problem(problem) && !uses_compensated_force(r.method.info))
+    throw invalid_input(compensated_force_refusal("compensated=True", r.method.info.name));
   if (problem == "kepler") return run_solve<std::array<double, 2>>(KeplerForce{}, r, false);
-  if (problem == "kepler_compensated") {
-    // Kepler(e, compensated=True): the force in double-word, used by the adaptive RKN pairs (as the tool's
-    // `run --force compensated`, with the same refusal).
-    if (!uses_compensated_force(r.method.info))
-      throw invalid_input(compensated_force_refusal("compensated=True", r.method.info.name));
-    return run_solve<std::array<double, 2>>(CompensatedKeplerForce{}, r, false);
-  }
+  if (problem == "kepler_compensated") return run_solve<std::array<double, 2>>(CompensatedKeplerForce{}, r, false);
   if (problem == "nbody" || problem == "nbody_compensated") {
     std::vector<double> gm(params.begin() + 1, params.end());
     if (gm.size() * 3 != r.q0.size()) throw invalid_input("N-body state must hold 3 coordinates per particle");
     if (problem == "nbody")
       return run_solve<std::vector<double>>(NBodyForce<double>(std::move(gm), params.at(0)), r, false);
-    // NBody(compensated=True): the force in double-word (CompensatedNBodyForce, on the inline path), as the tool's
-    // `run --problem nbody --force compensated`, with the same refusal.
-    if (!uses_compensated_force(r.method.info))
-      throw invalid_input(compensated_force_refusal("compensated=True", r.method.info.name));
     return run_solve<std::vector<double>>(CompensatedNBodyForce<double>(std::move(gm), params.at(0)), r, false);
   }
   if (problem == "henon_heiles" || problem == "harmonic")

@@ -134,4 +134,11 @@ S to_scalar(const bigcomplex& x) {
   }
 }
 
+/// The rounding residual of a real reference value rounded to the working type S (exact minus rounded,
+/// rounded = to_scalar<S>(exact)): the low part of the double-word that carries the exact coefficient.
+template <class S>
+S rounding_residual(const bigcomplex& exact, const S& rounded) {
+  return to_scalar<S>(exact - bigcomplex(bigfloat(rounded)));
+}
+
 }  // namespace nystrom

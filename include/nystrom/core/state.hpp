@@ -88,6 +88,16 @@ template <class F, class V>
 inline constexpr bool takes_carry_v =
     std::conjunction_v<std::is_invocable<F&, const V&, const V&, V&, V&>, std::is_invocable<F&, const V&, V&>>;
 
+/// Whether two states hold the same values, element by element (a NaN is never the same): the engines' test that
+/// a cached force or carry still belongs to the state they are given.
+template <class V>
+bool same_values(const V& x, const V& y) {
+  if (x.size() != y.size()) return false;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (!(x[i] == y[i])) return false;
+  return true;
+}
+
 template <class V>
 struct is_std_array : std::false_type {};
 template <class S, std::size_t N>
@@ -163,7 +173,7 @@ struct Compensator {
 
   /// Start (or continue, if s is the state last left) a compensated run.
   void begin(const State<V>& s) {
-    if (valid && same(lastq, s.q) && same(lastv, s.v)) return;
+    if (valid && same_values(lastq, s.q) && same_values(lastv, s.v)) return;
     resize_like(cq, s.q);
     resize_like(cv, s.v);
     for (auto& e : cq) e = typename V::value_type(0);
@@ -200,14 +210,6 @@ struct Compensator {
   template <class C>
   void axpy_v(V& v, const C& c, const V& x) {
     for (std::size_t i = 0; i < v.size(); ++i) compensated_add(v[i], cv[i], typename V::value_type(c * x[i]));
-  }
-
- private:
-  static bool same(const V& x, const V& y) {
-    if (x.size() != y.size()) return false;
-    for (std::size_t i = 0; i < x.size(); ++i)
-      if (!(x[i] == y[i])) return false;
-    return true;
   }
 };
 

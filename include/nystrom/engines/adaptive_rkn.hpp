@@ -142,8 +142,7 @@ AdaptiveRknIntegrator<V, F> make_adaptive_integrator(const MethodDef& def, F for
     auto residuals = [](const std::vector<bigcomplex>& exact, const std::vector<S>& rounded) {
       std::vector<S> r;
       r.reserve(exact.size());
-      for (std::size_t i = 0; i < exact.size(); ++i)
-        r.push_back(to_scalar<S>(exact[i] - bigcomplex(bigfloat(rounded[i]))));
+      for (std::size_t i = 0; i < exact.size(); ++i) r.push_back(rounding_residual(exact[i], rounded[i]));
       return r;
     };
     tab.c_lo = residuals(t->c, tab.c);

@@ -81,7 +81,7 @@ class Integrator {
     std::vector<S> lo;
     lo.reserve(exact.steps.size());
     for (std::size_t i = 0; i < exact.steps.size(); ++i)
-      lo.push_back(to_scalar<S>(exact.steps[i].coef - bigcomplex(bigfloat(rounded.steps[i].coef))));
+      lo.push_back(rounding_residual(exact.steps[i].coef, rounded.steps[i].coef));
     return {std::move(rounded), std::move(lo)};
   }
 

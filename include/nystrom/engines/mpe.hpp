@@ -185,7 +185,7 @@ class MpeStepper {
     }
     products_.resize(P);
     lows_.resize(P);
-    V a0{}, a0lo{}, a{}, alo{}, cq{}, cv{};
+    V a0{}, a0lo{}, a{}, alo{};
     resize_like(a0, s.q);
     resize_like(a0lo, s.q);
     for (long step = 0; step < n; ++step) {
@@ -195,24 +195,22 @@ class MpeStepper {
       }
       for (std::size_t i = 0; i < P; ++i) {
         State<V>& x = products_[i];
+        State<V>& lo = lows_[i];  // the product's carries, then its increment's low part
         x = s;
+        lo.q = comp_.cq;
+        lo.v = comp_.cv;
         a = a0;
         alo = a0lo;
-        cq = comp_.cq;
-        cv = comp_.cv;
         bool valid = starts_with_kick_;
-        base_.advance_carried(x, a, alo, valid, carried_.data() + i * m, k_[i], cq, cv);
-        // The increment as a double-word: (x - s) + (carry_i - carry), its high part from an exact two-sum,
-        // kept in x (high) and the product's carries (low).
+        base_.advance_carried(x, a, alo, valid, carried_.data() + i * m, k_[i], lo.q, lo.v);
+        // The increment as a double-word: (x - s) + (carry_i - carry), its high part from an exact two-sum.
         for (std::size_t j = 0; j < s.q.size(); ++j) {
           S e;
           x.q[j] = eft::two_sum(x.q[j], S(-s.q[j]), e);
-          cq[j] = e + (cq[j] - comp_.cq[j]);
+          lo.q[j] = e + (lo.q[j] - comp_.cq[j]);
           x.v[j] = eft::two_sum(x.v[j], S(-s.v[j]), e);
-          cv[j] = e + (cv[j] - comp_.cv[j]);
+          lo.v[j] = e + (lo.v[j] - comp_.cv[j]);
         }
-        lows_[i].q = cq;
-        lows_[i].v = cv;
       }
       // T_ref + sum_{i != ref} c_i (T_i - T_ref): the differences of the increments (of the order of the base's
       // local error) rounded once, the reference increment added as a double-word by an exact two-sum.

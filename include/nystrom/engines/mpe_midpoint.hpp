@@ -75,7 +75,7 @@ class MidpointMpeIntegrator {
     resize_like(dq_, s.q);
     resize_like(dv_, s.q);
     // The force at the start: kept from the last attempt if it started from this state (a rejected step).
-    if (!(start_valid_ && same(sq_, s.q) && same(sv_, s.v))) {
+    if (!(start_valid_ && same_values(sq_, s.q) && same_values(sv_, s.v))) {
       force_(static_cast<const V&>(s.q), static_cast<const V&>(s.v), f0_);
       ++evals_;
       resize_like(sq_, s.q);
@@ -141,13 +141,6 @@ class MidpointMpeIntegrator {
         z_.v[i] = v;
       }
     }
-  }
-
-  static bool same(const V& x, const V& y) {
-    if (x.size() != y.size()) return false;
-    for (std::size_t i = 0; i < x.size(); ++i)
-      if (!(x[i] == y[i])) return false;
-    return true;
   }
 
   std::vector<long> k_;

@@ -146,8 +146,8 @@ class RknStepper {
       if (i == 0 && fsal_ && cache_valid_) {
         // f_[0] holds the force at the end of the last step, f_[s-1] the one at its start (a step that the
         // controller rejected starts there again).
-        bool reuse = same(aq_, st.q) && (!velocity_dependent || same(av_, st.v));
-        if (!reuse && same(sq_, st.q) && (!velocity_dependent || same(sv_, st.v))) {
+        bool reuse = same_values(aq_, st.q) && (!velocity_dependent || same_values(av_, st.v));
+        if (!reuse && same_values(sq_, st.q) && (!velocity_dependent || same_values(sv_, st.v))) {
           std::swap(f_[0], f_[s - 1]);
           if constexpr (carried_force) std::swap(fl_[0], fl_[s - 1]);
           reuse = true;
@@ -407,13 +407,6 @@ class RknStepper {
     }
     using std::abs;
     return abs((target - hi) - lo) <= scalar_type(64) * std::numeric_limits<scalar_type>::epsilon();
-  }
-
-  static bool same(const V& x, const V& y) {
-    if (x.size() != y.size()) return false;
-    for (std::size_t i = 0; i < x.size(); ++i)
-      if (!(x[i] == y[i])) return false;
-    return true;
   }
 
   RknTableau<scalar_type> t_;

@@ -503,25 +503,9 @@ class SplittingStepper {
     }
   }
 
-  static bool same_values(const V& x, const V& y) {
-    if (x.size() != y.size()) return false;
-    for (std::size_t i = 0; i < x.size(); ++i)
-      if (!(x[i] == y[i])) return false;
-    return true;
-  }
-
   // The cache survives between calls only if the caller did not move q.
   void check_cache(const V& q) {
-    if (!cache_valid_) return;
-    if (aq_.size() != q.size()) {
-      cache_valid_ = false;
-      return;
-    }
-    for (std::size_t i = 0; i < q.size(); ++i)
-      if (!(aq_[i] == q[i])) {
-        cache_valid_ = false;
-        return;
-      }
+    if (cache_valid_ && !same_values(aq_, q)) cache_valid_ = false;
   }
   void remember(const V& q) {
     if (cache_valid_) {

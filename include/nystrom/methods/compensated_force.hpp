@@ -2,9 +2,8 @@
 // RKN pairs, whose precise update takes it (engines/rkn.hpp), and the splitting, composition and fixed-step
 // multi-product methods with real coefficients, whose compensated drifts and kicks take it (engines/splitting.hpp,
 // engines/mpe.hpp); every other engine (the adaptive multi-product expansion, the fixed-step RKN tableaux, complex
-// coefficients) calls force(q, a). The tool
-// (`run --force compensated`) and the Python module (`Kepler(e, compensated=True)`) refuse it for any other method
-// with the same line.
+// coefficients) calls force(q, a). The tool (`run --force compensated`) and the Python module (`Kepler(e,
+// compensated=True)`, `NBody(..., compensated=True)`) refuse it for any other method with the same line.
 #pragma once
 
 #include <string>

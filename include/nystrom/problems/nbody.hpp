@@ -613,11 +613,7 @@ class NBodyForce {
 
   template <class V>
   void operator()(const V& q, V& a) const {
-    const std::size_t n = size();
-    if (n == 0) throw std::invalid_argument("N-body force used without a particle set");
-    if (q.size() != 3 * n)
-      throw std::invalid_argument("N-body state has " + std::to_string(q.size()) + " coordinates, expected 3 x " +
-                                  std::to_string(n));
+    check_state(q);
     resize_like(a, q);
     const int nt = threads > 0 ? threads : nbody_max_threads();
 #if NYSTROM_HAVE_AVX512_KERNEL
@@ -630,6 +626,16 @@ class NBodyForce {
     }
 #endif
     generic_force(q, a, nt);
+  }
+
+  /// Throws std::invalid_argument unless q holds 3 coordinates for each of the particles (at least one).
+  template <class V>
+  void check_state(const V& q) const {
+    const std::size_t n = size();
+    if (n == 0) throw std::invalid_argument("N-body force used without a particle set");
+    if (q.size() != 3 * n)
+      throw std::invalid_argument("N-body state has " + std::to_string(q.size()) + " coordinates, expected 3 x " +
+                                  std::to_string(n));
   }
 
   /// The generic kernel: a_i summed over j = 0..N-1 in order, OpenMP across i.
@@ -765,14 +771,11 @@ class CompensatedNBodyForce : public NBodyForce<T> {
     using eft::fast_two_sum;
     using eft::two_prod;
     using eft::two_sum;
-    const std::size_t nn = this->size();
-    if (nn == 0) throw std::invalid_argument("N-body force used without a particle set");
-    if (q.size() != 3 * nn || cq.size() != q.size())
-      throw std::invalid_argument("N-body state has " + std::to_string(q.size()) + " coordinates, expected 3 x " +
-                                  std::to_string(nn));
+    this->check_state(q);
+    this->check_state(cq);
     resize_like(a, q);
     resize_like(alo, q);
-    const long n = static_cast<long>(nn);
+    const long n = static_cast<long>(this->size());
     const auto& masses = this->masses();
     const S eps2 = S(this->eps2());
     const int nt = this->threads > 0 ? this->threads : nbody_max_threads();

@@ -123,7 +123,7 @@ struct EngineForce {
       a[n] = typename VE::value_type(0);
     }
   }
-  // A compensated force (takes_carry_v) keeps its form for the precise update of the adaptive RKN pairs.
+  // A compensated force (takes_carry_v) keeps its form for the engines that take its low parts.
   void operator()(const VE& q, const VE& cq, VE& a, VE& alo) requires(!VD && !TD && takes_carry_v<F, VE>) {
     f(q, cq, a, alo);
     check_size(a, q.size());
