@@ -405,17 +405,20 @@ class ToleranceProportionality : public testing::TestWithParam<std::string> {};
 // double at tol 1e-6 and 1e-9 (the controller's defaults). Every adaptive pair here propagates the
 // solution of order p and controls an embedded one of order e = p - 2 (DP12(10); the multi-product pairs,
 // engines/adaptive_mpe.hpp) or the order its general (RKNG) pair declares (Fine 4(3), 5(4); DOP853's stretched
-// estimate from its weights of orders 5 and 3 behaves like an error of order 7):
-// steps h ~ tol^(1/(e+1)), local errors of the propagated solution h^(p+1), so the global error goes like
-// tol^(p/(e+1)) and the 1000x tighter tolerance divides it by 1000^(p/(e+1)) (DP12 1874, M6 3981). Accepted: that ratio
-// within a factor 4 (1000^0.2) either way -- one period is 10-60 steps, whose number moves in integer jumps (measured:
-// DP12 1108, M6 3576, M10 729, M14 2661, mpe-vv 1,2,3,4 2608). This fails exponents off by 0.2 or more (an error merely
-// proportional to tol, a controller that does not follow tol); an embedded order off by one moves the
-// exponent of these high orders by less, and is checked directly (test_adaptive_mpe,
-// EmbeddedEstimateHasItsOrder; test_adaptive_rkn, error_order). The error itself stays below tol (the
-// controller aims at safety^(p-1) tol for the estimate, and local extrapolation propagates the more
-// accurate solution; measured 0.02-0.5 tol) and above 0.003 tol (an estimator that overestimates by
-// a power of h would spend far more forces for errors far below tol).
+// estimate from its weights of orders 5 and 3 behaves like an error of order 7). Under plain error-per-step
+// control the pairs with e = p - 2 were measured to make a global error ~ tol^((p+1)/(e+1)) (DP12 tol^1.18, M6
+// tol^1.4); their controller works to the tolerance tol_c = anchor (tol / anchor)^gamma with gamma = (e+1)/(p+1)
+// (the method's tolerance_exponent and tolerance_anchor; engines/step_control.hpp, controlled_tolerance), so that
+// the error follows tol itself, as it does for the pairs with e = p - 1 under plain control. The 1000x tighter
+// tolerance then divides the error by about 1000. Accepted: within a factor 8 (1000^0.3) either way -- one period is
+// 10-60 steps, whose number moves in integer jumps, and is short of the regime of the calibration (measured: DP12
+// 2628, M10 132, M14 935, DOP853 372). This fails a controller that does not follow tol (a ratio of 1) and the
+// uncalibrated exponents of the low orders (M4 tol^1.67); an embedded order off by one is checked directly
+// (test_adaptive_mpe, EmbeddedEstimateHasItsOrder; test_adaptive_rkn, error_order), the proportionality over
+// 1e-6..1e-15 on 100 orbits through the tool (test_adaptive_floor_cli). The error itself stays below tol (the
+// controller aims at safety^(p-1) tol_c <= tol for the estimate, and local extrapolation propagates the more
+// accurate solution) and above 0.003 tol_c (an estimator that overestimates by a power of h would spend far more
+// forces for errors far below tol_c).
 TEST_P(ToleranceProportionality, ErrorFollowsTheTolerance) {
   const MethodDef def = resolve_method(GetParam());
   ASSERT_TRUE(def.info.adaptive) << GetParam();
@@ -438,14 +441,16 @@ TEST_P(ToleranceProportionality, ErrorFollowsTheTolerance) {
   // estimate, Fine's pairs) gains nothing from local extrapolation: its global error is the sum of the local
   // errors of its 30-200 steps, each held at the tolerance (measured 6 to 11 tol).
   const double bound = def.info.order == e + 1 ? 20 : 1;
+  const double gamma = def.info.tolerance_exponent > 0 ? def.info.tolerance_exponent : 1.0;
+  const double loose_c = adaptive_detail::controlled_tolerance(1e-6, gamma, def.info.tolerance_anchor);
+  const double tight_c = adaptive_detail::controlled_tolerance(1e-9, gamma, def.info.tolerance_anchor);
   EXPECT_LT(loose.position_error, bound * 1e-6);
   EXPECT_LT(tight.position_error, bound * 1e-9);
-  EXPECT_GT(loose.position_error, 0.003 * 1e-6);
-  EXPECT_GT(tight.position_error, 0.003 * 1e-9);
-  const double predicted = std::pow(1000.0, p / (e + 1));
+  EXPECT_GT(loose.position_error, 0.003 * loose_c);
+  EXPECT_GT(tight.position_error, 0.003 * tight_c);
   const double ratio = loose.position_error / tight.position_error;
-  EXPECT_GT(ratio, predicted / 4) << "predicted " << predicted;
-  EXPECT_LT(ratio, predicted * 4) << "predicted " << predicted;
+  EXPECT_GT(ratio, 1000.0 / 8);
+  EXPECT_LT(ratio, 1000.0 * 8);
   EXPECT_GT(tight.force_evals, loose.force_evals);
 }
 

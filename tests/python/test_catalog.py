@@ -10,9 +10,12 @@ def test_methods_lists_families_with_their_fields():
     cat = nystrom.methods()
     assert len(cat) >= 20
     keys = {"name", "family", "order", "stages", "forces_per_step", "fsal", "symmetric", "symplectic", "complex",
-            "adaptive", "published_digits", "aliases", "source", "description"}
+            "adaptive", "published_digits", "tolerance_exponent", "aliases", "source", "description"}
     for m in cat:
         assert keys <= set(m)
+        # The controller's tolerance exponent: in (0.5, 1] for an adaptive method, None for fixed steps.
+        assert (m["tolerance_exponent"] is None) == (not m["adaptive"])
+        assert m["tolerance_exponent"] is None or 0.5 <= m["tolerance_exponent"] <= 1
         assert m["family"] in {"splitting", "composition", "rkn", "mpe", "extrapolation"}
         assert m["order"] >= 2
     names = {m["name"]: m for m in cat}
@@ -21,6 +24,8 @@ def test_methods_lists_families_with_their_fields():
     assert names["FR"]["order"] == 4 and names["FR"]["symplectic"]
     assert names["DP12"]["family"] == "rkn" and names["DP12"]["order"] == 12
     assert names["Chambers"]["complex"]
+    # DP12's controller works to a calibrated tolerance (its global error grows faster than tol); DOP853's does not.
+    assert names["DP12-adaptive"]["tolerance_exponent"] < 1 and names["DOP853-adaptive"]["tolerance_exponent"] == 1
     # GBS closes the list: adaptive in step and order, up to order 2 x 12 columns by default.
     assert cat[-1]["name"] == "GBS" and cat[-1]["family"] == "extrapolation"
     assert cat[-1]["order"] == 24 and cat[-1]["adaptive"] and cat[-1]["forces_per_step"] == 0

@@ -320,6 +320,21 @@ TEST(Solve, StepControlOptionsAreFlatAndRefusedWhereTheyDoNotApply) {
   EXPECT_THROW(solve(prob, "DP12-adaptive", {.rtol = 1e-8, .h0 = -1}), invalid_input);
   EXPECT_THROW(solve(prob, "DP12-adaptive", {.rtol = 1e-8, .safety = 1.5}), invalid_input);
   EXPECT_THROW(solve(prob, "DP12-adaptive", {.rtol = 1e-8, .fac_max = 0.5}), invalid_input);
+  // the calibrated tolerance (tolerance proportionality) works to a tighter tolerance than tol above 1e-15: plain
+  // control (exponent 1) takes fewer steps (ten orbits at 1e-6: 25x looser); the method's own exponent and anchor
+  // given explicitly are the same run
+  const auto orbits = kepler(0.5, 0.0, 20 * std::numbers::pi);
+  const auto calibrated = solve(orbits, "DP12-adaptive", {.rtol = 1e-6});
+  const auto plain = solve(orbits, "DP12-adaptive", {.rtol = 1e-6, .tolerance_exponent = 1});
+  EXPECT_LT(static_cast<double>(plain.accepted), 0.9 * static_cast<double>(calibrated.accepted));
+  const auto same =
+      solve(orbits, "DP12-adaptive", {.rtol = 1e-6, .tolerance_exponent = 11.0 / 13.0, .tolerance_anchor = 1e-15});
+  EXPECT_EQ(same.accepted, calibrated.accepted);
+  EXPECT_EQ(same.q_final, calibrated.q_final);
+  EXPECT_THROW(solve(prob, "M8", {.steps = 100, .tolerance_exponent = 1}), invalid_input);
+  EXPECT_THROW(solve(prob, "GBS", {.rtol = 1e-10, .tolerance_anchor = 1e-12}), invalid_input);
+  EXPECT_THROW(solve(prob, "DP12-adaptive", {.rtol = 1e-8, .tolerance_exponent = 0.2}), invalid_input);
+  EXPECT_THROW(solve(prob, "DP12-adaptive", {.rtol = 1e-8, .tolerance_anchor = -1}), invalid_input);
 }
 
 TEST(Solve, AForceReturningNaNIsReportedWithTheTime) {

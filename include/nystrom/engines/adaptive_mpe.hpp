@@ -379,8 +379,9 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   // The natural sequence k = 1..N on a Verlet base (HNW I, sec. II.9, ODEX, carried over from the GBS columns to
   // the products): a step of target n runs the products k = 1..n in lockstep, the longest first in every
   // sub-step, so that products 1..n-1 are complete one pair before product n. Then the convergence monitor:
-  //   * err_{n-1}, the estimate of T_{2n-2} - T_{2n-4} (products 1..n-1, free), <= 1: the step is accepted with
-  //     T_{2n-2}, without the last force(s) of product n;
+  //   * err_{n-1}, the estimate of T_{2n-2} - T_{2n-4} (products 1..n-1, free), <= 1 and n - 1 >= 3: the step is
+  //     accepted with T_{2n-2}, without the last force(s) of product n (with n - 1 = 2 product n completes, and
+  //     T_4 is taken only when T_6 fails);
   //   * err_{n-1} not finite (the force returned NaN or inf): the step is rejected at once;
   //   * else product n completes, and the step is accepted with T_2n when err_n <= 1.
   // Then order and step: H_j = h * ratio_j (the step ratio of order j by the controller of the fixed-order
@@ -430,7 +431,8 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
     for (std::size_t n = 1; n <= N + 1; ++n) work_[n] = static_cast<double>(n) + 3;
   }
 
-  // The smallest target: three products (the step can still stop at two), so that every full step has the
+  // The smallest target: three products (which always complete: a step taken with two products, whose order 4
+  // has no lower estimate to weigh against, could not raise the order again), so that every step has the
   // estimates of two orders to choose from; two when that is the largest.
   int nmin_target() const { return std::min(3, nmax_); }
 
@@ -494,7 +496,9 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
         if (n - 1 < 2) return true;
         oc_combine(static_cast<std::size_t>(n - 1), x, inc_lo, err_lo);
         e2_lo = adaptive_detail::error_norm2(s, inc_lo, err_lo, err_scale, ocnoise_[static_cast<std::size_t>(n - 1)]);
-        if (e2_lo <= 1.0) {
+        // Two products (order 4) have no lower estimate to weigh against: a step taken there could never raise the
+        // order again (its step ratio is about 1 in a steady run, never fac_max), so the step completes product n.
+        if (e2_lo <= 1.0 && n - 1 >= 3) {
           taken = n - 1;
           return false;
         }
@@ -510,6 +514,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
           e2 = adaptive_detail::error_norm2(s, inc, err, err_scale, ocnoise_[static_cast<std::size_t>(n)]);
           if (e2 <= 1.0) taken = n;
           if (n - 1 >= 2) elo = e2_lo;
+          if (!taken && n - 1 == 2 && e2_lo <= 1.0) taken = n - 1;  // order 6 failed where order 4 passed
         } else if (n - 2 >= 2) {  // stopped after products 1..n-1: the estimate of order 2n - 4 as well
           oc_combine(static_cast<std::size_t>(n - 2), x, inc, err);
           elo = adaptive_detail::error_norm2(s, inc, err, err_scale, ocnoise_[static_cast<std::size_t>(n - 2)]);
@@ -597,6 +602,8 @@ AdaptiveMpeIntegrator<V, F> make_adaptive_mpe_integrator(const MethodDef& def, F
                                                          EngineOptions eopt = {}) {
   using S = typename V::value_type;
   opt.validate();
+  if (opt.tolerance_exponent == 0) opt.tolerance_exponent = def.info.tolerance_exponent;
+  if (opt.tolerance_anchor == 0) opt.tolerance_anchor = def.info.tolerance_anchor;
   const auto data = shared_method_data_for(def, scalar_traits<S>::bits(), scalar_traits<S>::name());
   const auto* m = std::get_if<MpeDef>(data.get());
   if (!m) throw std::invalid_argument("method '" + def.info.name + "' is not a multi-product method");

@@ -129,6 +129,8 @@ AdaptiveRknIntegrator<V, F> make_adaptive_integrator(const MethodDef& def, F for
                                                      EngineOptions eopt = {}) {
   using S = typename V::value_type;
   opt.validate();
+  if (opt.tolerance_exponent == 0) opt.tolerance_exponent = def.info.tolerance_exponent;
+  if (opt.tolerance_anchor == 0) opt.tolerance_anchor = def.info.tolerance_anchor;
   // Coefficients at the reference precision; the working values are created outside it (mpfr_real).
   const auto data = shared_method_data_for(def, scalar_traits<S>::bits(), scalar_traits<S>::name());
   const auto* t = std::get_if<RknTableau<bigcomplex>>(data.get());

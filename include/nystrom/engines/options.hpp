@@ -20,6 +20,13 @@ struct AdaptiveOptions {
   long max_steps = 10000000;  // accepted + rejected steps per integrate_to call
   int error_order = 0;        // p, the lower order of the pair; 0: determined from the tableau
   bool predictive = true;     // Gustafsson's predictive step ratio as well (adaptive_detail::StepController)
+  // The tolerance the controller works to, tol_c = anchor (tol / anchor)^gamma above the anchor and tol below it
+  // (tolerance proportionality: the global error follows tol; adaptive_detail::controlled_tolerance): the exponent
+  // gamma and the anchor. 0: the method's (MethodInfo::tolerance_exponent and tolerance_anchor, set by
+  // make_adaptive_integrator and make_adaptive_mpe_integrator; gamma 1 for an engine built directly, anchor
+  // 1e-15); gamma 1: tol itself (plain error-per-step control).
+  double tolerance_exponent = 0;
+  double tolerance_anchor = 0;
 
   void validate() const {
     if (!std::isfinite(rtol) || !(rtol >= 0)) throw std::invalid_argument("tolerance must be a finite number >= 0");
@@ -33,6 +40,10 @@ struct AdaptiveOptions {
     if (!std::isfinite(h_max) || h_max < 0) throw std::invalid_argument("h_max must be finite and >= 0");
     if (max_steps <= 0) throw std::invalid_argument("max_steps must be positive");
     if (error_order < 0) throw std::invalid_argument("error_order must be >= 0");
+    if (!(tolerance_exponent == 0 || (tolerance_exponent >= 0.5 && tolerance_exponent <= 1)))
+      throw std::invalid_argument("tolerance_exponent must be 0 (the method's) or in [0.5, 1]");
+    if (!std::isfinite(tolerance_anchor) || !(tolerance_anchor >= 0) || tolerance_anchor > 1e-3)
+      throw std::invalid_argument("tolerance_anchor must be 0 (the method's) or in (0, 1e-3]");
   }
 };
 

@@ -301,7 +301,9 @@ inline std::vector<MethodDef> dormand_prince1987() {
         .source = src,
         .description =
             "Dormand-El-Mikkawy-Prince RKN12(10) pair with step-size control (error from the 10th-order weights)",
-        .aliases = {"DPRKN12-adaptive", "RKN12(10)"}},
+        .aliases = {"DPRKN12-adaptive", "RKN12(10)"},
+        // (e + 1) / (p + 1) = 11/13: error ~ tol^1.24, tol^1.19 (Kepler e = 0.5, 0.9), tol^1.12 (outer solar system)
+        .tolerance_exponent = 11.0 / 13.0},
        [] { return MethodData{dprkn12_10_tableau()}; }});
   return m;
 }

@@ -33,6 +33,11 @@ struct MethodInfo {
   std::string source;        // the publication the coefficients come from
   std::string description;
   std::vector<std::string> aliases;
+  // Adaptive methods: the exponent gamma and the anchor of the controller's tolerance (engines/step_control.hpp,
+  // controlled_tolerance); gamma is the inverse of the measured growth of the global error with the tolerance
+  // (error ~ tol^(1/gamma) under plain error-per-step control). 0: none (gamma 1), the default anchor 1e-15.
+  double tolerance_exponent = 0;
+  double tolerance_anchor = 0;
 };
 
 /// A multi-product method: the sequence {k_i} and the symmetric second-order base T_2. order_control: the

@@ -753,17 +753,18 @@ inline void check_tolerances(const MethodDef& def, const SolveOptions& opt) {
 
 /// Throws invalid_input when an option of the step control is set for a method that has no use for it
 /// (instead of ignoring it): h0 applies to the adaptive methods and GBS, h_max, safety, fac_min, fac_max,
-/// predictive and error_order to the adaptive RKN and MPE methods.
+/// predictive, error_order, tolerance_exponent and tolerance_anchor to the adaptive RKN and MPE methods.
 inline void check_step_control(const MethodDef& def, const SolveOptions& opt, bool gbs) {
   const SolveOptions d{};
   const bool controller = opt.h_max != d.h_max || opt.safety != d.safety || opt.fac_min != d.fac_min ||
                           opt.fac_max != d.fac_max || opt.predictive != d.predictive ||
-                          opt.error_order != d.error_order;
+                          opt.error_order != d.error_order || opt.tolerance_exponent != d.tolerance_exponent ||
+                          opt.tolerance_anchor != d.tolerance_anchor;
   const bool adaptive = def.info.adaptive && !gbs;
   if (controller && !adaptive)
     throw invalid_input(
-        "h_max, safety, fac_min, fac_max, predictive and error_order apply to the adaptive RKN and "
-        "MPE methods, not to '" +
+        "h_max, safety, fac_min, fac_max, predictive, error_order, tolerance_exponent and tolerance_anchor apply "
+        "to the adaptive RKN and MPE methods, not to '" +
         def.info.name + "'");
   if (opt.h0 != d.h0 && !adaptive && !gbs)
     throw invalid_input("h0 (the first step) applies to adaptive methods and GBS; '" + def.info.name +

@@ -37,13 +37,17 @@ struct SolveOptions {
   /// Adaptive RKN and MPE methods only (solve() refuses them for GBS and fixed steps when not at these
   /// defaults): the largest step (0: the span); the safety factor on the optimal step, in (0, 1]; the
   /// smallest and largest step ratio per step; Gustafsson's predictive step ratio as well; the order p of
-  /// the error estimate (0: from the method).
+  /// the error estimate (0: from the method); the exponent and the anchor of the controller's tolerance (0: the
+  /// method's calibration, MethodInfo::tolerance_exponent and tolerance_anchor; exponent 1: tol itself;
+  /// AdaptiveOptions::tolerance_exponent).
   double h_max = 0;
   double safety = 0.9;
   double fac_min = 0.2;
   double fac_max = 4.0;
   bool predictive = true;
   int error_order = 0;
+  double tolerance_exponent = 0;
+  double tolerance_anchor = 0;
   /// Complex-coefficient methods: keep the complexified state instead of dropping the imaginary parts
   /// after every step (the default drops them, as in the Gurkan paper).
   bool keep_complex = false;
@@ -101,6 +105,8 @@ inline AdaptiveOptions adaptive_options(const SolveOptions& opt) {
   ao.fac_max = opt.fac_max;
   ao.predictive = opt.predictive;
   ao.error_order = opt.error_order;
+  ao.tolerance_exponent = opt.tolerance_exponent;
+  ao.tolerance_anchor = opt.tolerance_anchor;
   return ao;
 }
 
