@@ -47,24 +47,30 @@ std::string tol_text(double tol) {
   return buf;
 }
 
-// 10^(-k/4) for k = k0 (24: 1e-6) on, as long as the tool accepts the tolerance; extra: more options.
-std::vector<Point> sweep(const std::string& method, double ecc, int k0 = 24, const std::string& extra = "") {
+// `command --tol 10^(-k/4) --json` for k = k0 (24: 1e-6) to k1, as long as the tool accepts the tolerance; the error
+// from the JSON key error_key.
+std::vector<Point> sweep_command(const std::string& command, const char* error_key, int k0, int k1) {
   std::vector<Point> pts;
-  for (int k = k0; k <= 80; ++k) {
+  for (int k = k0; k <= k1; ++k) {
     const double tol = std::pow(10.0, -k / 4.0);
-    const auto r = run("run --problem kepler --periods 100 --ecc " + tol_text(ecc) + " --method " + method + " --tol " +
-                       tol_text(tol) + extra + " --json");
+    const auto r = run(command + " --tol " + tol_text(tol) + " --json");
     if (r.code != 0) {
       // The first refused tolerance ends the sweep: a clear one-line usage error.
-      EXPECT_EQ(r.code, 2) << method << " tol " << tol << ": " << r.err;
+      EXPECT_EQ(r.code, 2) << command << " tol " << tol << ": " << r.err;
       EXPECT_NE(r.err.find("nystrom: error: "), std::string::npos) << r.err;
       EXPECT_NE(r.err.find("tolerance"), std::string::npos) << r.err;
       break;
     }
     const auto j = nlohmann::json::parse(r.out);
-    pts.push_back({tol, j.at("position_error").get<double>(), j.at("steps").get<long>()});
+    pts.push_back({tol, j.at(error_key).get<double>(), j.at("steps").get<long>()});
   }
   return pts;
+}
+
+// Kepler over 100 periods from tolerance 10^(-k0/4) down to the tightest the tool accepts; extra: more options.
+std::vector<Point> sweep(const std::string& method, double ecc, int k0 = 24, const std::string& extra = "") {
+  return sweep_command("run --problem kepler --periods 100 --ecc " + tol_text(ecc) + " --method " + method + extra,
+                       "position_error", k0, 80);
 }
 
 // sum |c_i| of the natural-sequence MPE of order 2n: c_i = prod_{j != i} i^2 / (i^2 - j^2).
@@ -163,17 +169,11 @@ TEST(AdaptiveFloorCli, M16AdaptiveEccentricity09) { check("M16-adaptive", 0.9, m
 // 0.9 and 1.7 decades over 1e-6..1e-15, in long double).
 TEST(AdaptiveFloorCli, OuterSolarSystemErrorFollowsTheTolerance) {
   for (const std::string method : {"DP12-adaptive", "M12-adaptive"}) {
-    std::vector<Point> pts;
-    for (int k = 24; k <= 51; ++k) {
-      const double tol = std::pow(10.0, -k / 4.0);
-      const auto r = run("run --problem outer-solar-system --years 1186 --h 100 --method " + method + " --tol " +
-                         tol_text(tol) + " --json");
-      ASSERT_EQ(r.code, 0) << r.err;
-      const auto j = nlohmann::json::parse(r.out);
-      pts.push_back({tol, j.at("jupiter_position_error").get<double>(), j.at("steps").get<long>()});
-      std::printf("[ oss   ] %-14s tol %-11.4g error %.3e steps %ld\n", method.c_str(), tol, pts.back().error,
-                  pts.back().steps);
-    }
+    const auto pts = sweep_command("run --problem outer-solar-system --years 1186 --h 100 --method " + method,
+                                   "jupiter_position_error", 24, 51);
+    ASSERT_EQ(pts.size(), 28u) << method << ": every tolerance from 1e-6 to 1.8e-13 accepted";
+    for (const auto& q : pts)
+      std::printf("[ oss   ] %-14s tol %-11.4g error %.3e steps %ld\n", method.c_str(), q.tol, q.error, q.steps);
     const ToleranceRatios r = decade_ratios(pts, 1e-13);
     std::printf("[ oss   ] %-14s largest error / tol per decade: %.2e .. %.2e\n", method.c_str(), r.lo, r.hi);
     EXPECT_EQ(r.decades, 7) << method;
