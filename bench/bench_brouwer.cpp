@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "brouwer_common.hpp"
 #include "nystrom/engines/adaptive_rkn.hpp"
 #include "nystrom/engines/integrator.hpp"
 #include "nystrom/methods/catalog.hpp"
@@ -35,9 +36,7 @@ namespace {
 using namespace nystrom;
 using V = std::array<double, 2>;
 
-struct Point {
-  double periods, energy, position;
-};
+using Point = bench::BrouwerPoint;
 
 struct Config {
   std::string method;
@@ -50,22 +49,6 @@ std::string fmt_tol(double tol) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2g", tol);
   return buf;
-}
-
-// Least-squares slope of log y against log x over the points with x >= x_min.
-double slope(const std::vector<Point>& pts, double x_min, bool energy) {
-  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (const auto& p : pts) {
-    const double y = energy ? p.energy : p.position;
-    if (p.periods < x_min || !(y > 0)) continue;
-    const double lx = std::log10(p.periods), ly = std::log10(y);
-    n += 1;
-    sx += lx;
-    sy += ly;
-    sxx += lx * lx;
-    sxy += lx * ly;
-  }
-  return n > 1 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : 0;
 }
 
 template <class Force>
@@ -81,11 +64,7 @@ std::vector<Point> run(const Config& c, double ecc, long periods, long& forces, 
   auto record = [&](long m, const ReferenceErrors& e) {
     pts.push_back({static_cast<double>(m), e.energy, e.position});
   };
-  // output after m = 1, 2, 5, 10, 20, 50, ... periods
-  std::vector<long> outs;
-  for (long d = 1; d <= periods; d *= 10)
-    for (long f : {1L, 2L, 5L})
-      if (f * d <= periods) outs.push_back(f * d);
+  const std::vector<long> outs = bench::brouwer_outputs(periods);  // 1, 2, 5, 10, ... periods
   if (c.steps_per_period > 0) {
     auto integ = make_integrator<V>(def, Force{});
     const double h = period / static_cast<double>(c.steps_per_period);
@@ -180,7 +159,7 @@ int main(int argc, char** argv) {
     }
     const double from = std::max(1.0, static_cast<double>(periods) / 1000);
     std::printf("  slopes over the last three decades: energy %.2f, position %.2f (Brouwer: 0.5, 1.5)\n",
-                slope(pts, from, true), slope(pts, from, false));
+                bench::brouwer_slope(pts, from, true), bench::brouwer_slope(pts, from, false));
     std::fflush(stdout);
   }
   if (out) {

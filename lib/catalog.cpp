@@ -30,6 +30,15 @@ inline bool any_complex(const std::vector<bigcomplex>& v) {
   return std::any_of(v.begin(), v.end(), [](const bigcomplex& x) { return !x.is_real(); });
 }
 
+/// Every adaptive method carries the values its controller uses, so that the listings (nystrom methods,
+/// nystrom.methods()) read them as they are: gamma 1 (plain control) where none was measured, and the engines'
+/// default anchor, 1e-15 (adaptive_detail::kToleranceAnchor).
+void controller_defaults(MethodInfo& in) {
+  if (!in.adaptive) return;
+  if (in.tolerance_exponent == 0) in.tolerance_exponent = 1;
+  if (in.tolerance_anchor == 0) in.tolerance_anchor = 1e-15;
+}
+
 /// Fills the fields of MethodInfo that follow from the coefficients.
 void finalize_info(MethodDef& d) {
   BigPrecision guard(128);
@@ -72,6 +81,7 @@ void finalize_info(MethodDef& d) {
       in.tolerance_anchor = std::pow(10.0, -std::min(15.0, 2.5 * in.order));
     }
   }
+  controller_defaults(in);
 }
 
 inline std::string lower(std::string s) {
@@ -235,6 +245,7 @@ MethodDef gbs_method_def(const GbsDef& gbs) {
   d.info.description = std::string("Gragg-Bulirsch-Stoer extrapolation, adaptive step and order up to ") +
                        std::to_string(2 * gbs.max_columns) + ", " + names[static_cast<int>(gbs.sequence)] +
                        " step numbers";
+  detail::controller_defaults(d.info);
   d.build = [gbs]() -> MethodData { return gbs; };
   return d;
 }
@@ -292,6 +303,7 @@ MethodDef midpoint_mpe_method_def(const std::vector<long>& k, const std::string&
   d.info.description =
       std::string("multi-product expansion over Gragg's modified midpoint rule (2k substeps), ") +
       (adaptive ? "adaptive step (embedded estimate: the products without the largest k)" : "fixed step");
+  detail::controller_defaults(d.info);
   d.build = [k]() -> MethodData { return MpeDef{k, "GM", {}, false}; };
   return d;
 }

@@ -29,10 +29,8 @@ nlohmann::json info_json(const nystrom::MethodInfo& m) {
           {"published_digits", m.published_digits},
           // the exponent and the anchor of the controller's tolerance (engines/step_control.hpp); null for
           // fixed steps
-          {"tolerance_exponent", m.adaptive ? nlohmann::json(m.tolerance_exponent > 0 ? m.tolerance_exponent : 1.0)
-                                            : nlohmann::json(nullptr)},
-          {"tolerance_anchor",
-           m.adaptive ? nlohmann::json(m.tolerance_anchor > 0 ? m.tolerance_anchor : 1e-15) : nlohmann::json(nullptr)},
+          {"tolerance_exponent", m.adaptive ? nlohmann::json(m.tolerance_exponent) : nlohmann::json(nullptr)},
+          {"tolerance_anchor", m.adaptive ? nlohmann::json(m.tolerance_anchor) : nlohmann::json(nullptr)},
           {"aliases", m.aliases},
           {"source", m.source},
           {"description", m.description}};

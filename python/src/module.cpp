@@ -69,10 +69,8 @@ py::dict info_dict(const MethodInfo& m) {
   d["velocity"] = m.velocity;
   d["published_digits"] = m.published_digits;
   // the exponent and the anchor of the controller's tolerance (engines/step_control.hpp); None for fixed steps
-  d["tolerance_exponent"] =
-      m.adaptive ? py::object(py::float_(m.tolerance_exponent > 0 ? m.tolerance_exponent : 1.0)) : py::none();
-  d["tolerance_anchor"] =
-      m.adaptive ? py::object(py::float_(m.tolerance_anchor > 0 ? m.tolerance_anchor : 1e-15)) : py::none();
+  d["tolerance_exponent"] = m.adaptive ? py::object(py::float_(m.tolerance_exponent)) : py::none();
+  d["tolerance_anchor"] = m.adaptive ? py::object(py::float_(m.tolerance_anchor)) : py::none();
   d["aliases"] = m.aliases;
   d["source"] = m.source;
   d["description"] = m.description;

@@ -359,29 +359,8 @@ TEST(AdaptiveMpeOrderControl, OrderRisesAsTheToleranceTightens) {
 // 1.5 times M16-adaptive's forces at the same tolerance (measured 1.0x).
 TEST(AdaptiveMpeOrderControl, LooseToleranceDoesNotStayAtOrderFour) {
   const auto sys = planetary::outer_solar_system<double>();
-  const std::size_t n = sys.mass.size();
-  auto force = [&](const VD& q, VD& a) {
-    std::fill(a.begin(), a.end(), 0.0);
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = i + 1; j < n; ++j) {
-        double d[3], r2 = 0;
-        for (int k = 0; k < 3; ++k) {
-          d[k] = q[3 * j + k] - q[3 * i + k];
-          r2 += d[k] * d[k];
-        }
-        const double inv3 = sys.G / (r2 * std::sqrt(r2));
-        for (int k = 0; k < 3; ++k) {
-          a[3 * i + k] += sys.mass[j] * inv3 * d[k];
-          a[3 * j + k] -= sys.mass[i] * inv3 * d[k];
-        }
-      }
-  };
-  State<VD> s0{VD(3 * n), VD(3 * n)};
-  for (std::size_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      s0.q[3 * i + k] = sys.x[i][k];
-      s0.v[3 * i + k] = sys.v[i][k];
-    }
+  const planetary::CartesianForce<double> force(sys);
+  const State<VD> s0{planetary::flatten(sys.x), planetary::flatten(sys.v)};
   const double span = 100 * 4332.59;  // days
   auto oc = make_adaptive_mpe_integrator<VD>(resolve_method("MPE-adaptive"), force, with_tol(1e-6));
   auto m16 = make_adaptive_mpe_integrator<VD>(resolve_method("M16-adaptive"), force, with_tol(1e-6));

@@ -441,7 +441,7 @@ TEST_P(ToleranceProportionality, ErrorFollowsTheTolerance) {
   // estimate, Fine's pairs) gains nothing from local extrapolation: its global error is the sum of the local
   // errors of its 30-200 steps, each held at the tolerance (measured 6 to 11 tol).
   const double bound = def.info.order == e + 1 ? 20 : 1;
-  const double gamma = def.info.tolerance_exponent, anchor = def.info.tolerance_anchor;  // 0: tol itself, 1e-15
+  const double gamma = def.info.tolerance_exponent, anchor = def.info.tolerance_anchor;  // as the engine reads them
   const double loose_c = adaptive_detail::controlled_tolerance(1e-6, gamma, anchor);
   const double tight_c = adaptive_detail::controlled_tolerance(1e-9, gamma, anchor);
   EXPECT_LT(loose.position_error, bound * 1e-6);

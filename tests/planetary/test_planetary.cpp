@@ -427,6 +427,50 @@ TEST(Jacobi, RoundTripAndDiagonalKineticEnergy) {
   EXPECT_NEAR(jacobi, inertial, 1e-14 * inertial);
 }
 
+// The direct methods' form of the system: the flat force is accelerations() bit for bit, the flat state round-trips,
+// and the barycentric system keeps the relative motion, with its centre of mass at rest at the origin.
+TEST(CartesianForm, FlatForceIsTheBodyForceBitwiseAndTheBarycentreIsAtRest) {
+  const PlanetarySystem<double> sys = outer_solar_system<double>();
+  std::vector<Vec3<double>> a, back;
+  accelerations(sys.G, sys.mass, sys.x, a);
+  const std::vector<double> q = flatten(sys.x);
+  std::vector<double> fa(7, 1.0);  // resized and overwritten
+  const CartesianForce<double> force(sys);
+  force(q, fa);
+  ASSERT_EQ(fa.size(), 3 * sys.size());
+  for (std::size_t i = 0; i < sys.size(); ++i)
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(fa[3 * i + k], a[i][k]) << i << ' ' << k;
+  unflatten(q, back);
+  EXPECT_EQ(back, sys.x);
+
+  const PlanetarySystem<LD> b = barycentric(outer_solar_system<LD>());
+  const PlanetarySystem<LD> h = outer_solar_system<LD>();
+  LD m = 0;
+  Vec3<LD> X{0, 0, 0}, P{0, 0, 0};
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    m += b.mass[i];
+    for (int k = 0; k < 3; ++k) {
+      X[k] += b.mass[i] * b.x[i][k];
+      P[k] += b.mass[i] * b.v[i][k];
+      // relative positions and velocities are those of the data
+      EXPECT_NEAR(static_cast<double>(b.x[i][k] - b.x[0][k]), static_cast<double>(h.x[i][k] - h.x[0][k]), 1e-17);
+      EXPECT_NEAR(static_cast<double>(b.v[i][k] - b.v[0][k]), static_cast<double>(h.v[i][k] - h.v[0][k]), 1e-19);
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LT(std::fabs(static_cast<double>(X[k] / m)), 1e-17);
+    EXPECT_LT(std::fabs(static_cast<double>(P[k] / m)), 1e-20);
+  }
+  // Hairer's barycentre itself moves: about 2.5 AU per thousand years
+  LD p2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    LD pk = 0;
+    for (std::size_t i = 0; i < h.size(); ++i) pk += h.mass[i] * h.v[i][k];
+    p2 += (pk / m) * (pk / m);
+  }
+  EXPECT_GT(static_cast<double>(std::sqrt(p2)) * 365250, 1.0);
+}
+
 // ---- Wisdom-Holman maps ---------------------------------------------------------------------------------------
 
 namespace {
