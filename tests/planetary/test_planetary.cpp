@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -157,6 +158,41 @@ TEST(KeplerDrift, ManyShortDriftsStayOnTheEllipse) {
     const double bound = 2 * kEps * 2 * static_cast<double>(kPi) * orbits * std::sqrt(steps) / (1 - e);
     EXPECT_LT(distance(x, xr), bound) << "e = " << e;
     EXPECT_NEAR(kepler_energy(1.0, x, v), -0.5, 50 * kEps * orbits) << "e = " << e;
+  }
+}
+
+// With carries, the drifts' increments are added by compensated summation and the carries move along the orbit:
+// over 5000 drifts the rms position error over 8 realizations (pericentre distance scaled by 1 + r 2^-50) against
+// the exact orbit falls 5-6x at e = 0.1 and 0.5 (measured 2.2e-13 against 1.3e-12 and 4.6e-13 against 2.8e-12) and
+// stays as it was at e = 0.9 (8.4e-12 against 9.5e-12), where the solver's own error dominates; without carries
+// the result is bitwise kepler_drift's.
+TEST(KeplerDrift, CarriesCompensateTheIncrements) {
+  const double h = 2 * static_cast<double>(kPi) / 100 + 1e-3;
+  const long steps = 5000;
+  for (double e : {0.1, 0.5, 0.9}) {
+    double comp2 = 0, plain2 = 0;
+    for (int r = 0; r < 8; ++r) {
+      const Vec3<double> x0{(1 - e) * (1 + r * std::ldexp(1.0, -50)), 0, 0}, v0 = pericentre_velocity(e, 1 - e);
+      Vec3<double> x = x0, v = v0, xp = x0, vp = v0, xs = x0, vs = v0, cx{}, cv{};
+      auto mu = [](std::size_t) { return 1.0; };
+      for (long i = 0; i < steps; ++i) {
+        kepler_drift_many<double>(1, h, mu, x.data(), v.data(), cx.data(), cv.data());
+        kepler_drift_many<double>(1, h, mu, xp.data(), vp.data());
+        kepler_drift(1.0, h, xs, vs);
+      }
+      EXPECT_EQ(xp, xs);
+      EXPECT_EQ(vp, vs);
+      Vec3<LD> xr, vr;
+      elliptic_analytic(1, {x0[0], x0[1], 0}, {v0[0], v0[1], 0}, LD(h) * steps, xr, vr);
+      Vec3<LD> xc;
+      for (int k = 0; k < 3; ++k) xc[k] = LD(x[k]) + cx[k];
+      comp2 += distance(xc, xr) * distance(xc, xr);
+      plain2 += distance(xp, xr) * distance(xp, xr);
+    }
+    const double comp = std::sqrt(comp2 / 8), plain = std::sqrt(plain2 / 8);
+    std::cout << "[ carries  ] e = " << e << ": rms position error " << comp << " compensated, " << plain << " plain"
+              << std::endl;
+    EXPECT_LT(comp, e < 0.8 ? plain / 3 : 1.5 * plain) << "e = " << e;
   }
 }
 
@@ -711,6 +747,49 @@ TEST(WisdomHolman, RefusesComplexAndUnknownMethods) {
   PlanetarySystem<double> bad = s;
   bad.mass[1] = -1;
   EXPECT_THROW((void)propagate(bad, "WH", 0.1, 10), std::invalid_argument);
+}
+
+// A splitting over the Jacobi flows adds every drift's and kick's increment with compensated summation when asked
+// (PropagateOptions::compensated; off by default): SABA(10,6,4) on the outer solar system at 150 days, whose
+// truncation lies below its round-off there, over 1000 Jupiter periods; the rms of the relative energy error over
+// four realizations (initial positions scaled by 1 + r 2^-50) falls by more than 2x (measured 1.1e-14 against
+// 9.6e-14); the default is the plain map, bitwise.
+TEST(WisdomHolman, CompensatedSplittingLowersTheRoundOff) {
+  using nystrom::Compensation;
+  const long steps = 29 * 1000;  // 29 steps of 150 days: 1.004 Jupiter periods
+  auto rms = [&](Compensation c) {
+    double sum = 0;
+    for (int r = 0; r < 4; ++r) {
+      PlanetarySystem<double> sys = outer_solar_system<double>();
+      for (std::size_t i = 1; i < sys.size(); ++i)
+        for (int k = 0; k < 3; ++k) sys.x[i][k] *= 1 + r * std::ldexp(1.0, -50);
+      PlanetarySystem<LD> l;
+      l.G = sys.G;
+      for (std::size_t i = 0; i < sys.size(); ++i) {
+        l.mass.push_back(sys.mass[i]);
+        l.x.push_back({sys.x[i][0], sys.x[i][1], sys.x[i][2]});
+        l.v.push_back({sys.v[i][0], sys.v[i][1], sys.v[i][2]});
+      }
+      const LD e0 = energy(l.G, l.mass, l.x, l.v);
+      PropagateOptions<double> opt;
+      opt.compensated = c;
+      const PropagateResult<double> res = propagate(sys, "SABA(10,6,4)", 150.0, steps, opt);
+      for (std::size_t i = 0; i < sys.size(); ++i)
+        for (int k = 0; k < 3; ++k) {
+          l.x[i][k] = res.system.x[i][k];
+          l.v[i][k] = res.system.v[i][k];
+        }
+      const double de = static_cast<double>(energy(l.G, l.mass, l.x, l.v) / e0 - 1);
+      sum += de * de;
+    }
+    return std::sqrt(sum / 4);
+  };
+  const double comp = rms(Compensation::on), plain = rms(Compensation::off);
+  EXPECT_EQ(rms(PropagateOptions<double>{}.compensated), plain);
+  std::cout << "[ carries  ] SABA(10,6,4), 1000 periods: rms energy error " << comp << " compensated, " << plain
+            << " plain" << std::endl;
+  EXPECT_LT(comp, plain / 2);
+  EXPECT_GT(plain, 1e-15);  // the plain map's round-off is what is measured
 }
 
 // The multi-product expansion over the planetary flows adds its combined increment with compensated summation

@@ -32,6 +32,12 @@
 // No state is kept between drifts: the path and the result depend on the arguments only, and kepler_drift_many
 // gives every orbit the bits kepler_drift gives it (tests/planetary/test_planetary.cpp).
 //
+// Compensated summation (kepler_drift_many with carries cx, cv): the increments (f - 1) x + g v and
+// fdot x + (gdot - 1) v are added with an exact two-sum, x + (dx + cx), whose rounding error becomes the new carry,
+// as the engines add their steps (core/state.hpp): the state's rounding then no longer accumulates over the drifts of
+// a long run (docs/performance.md, "Long runs"). The orbit is solved from the rounded x, v; the carries are moved
+// along it by the same f and g (to first order: the f and g of the exact state differ in their last bits).
+//
 // Cost (bench/bench_planetary.cpp, outer solar system's Jacobi orbits, h = 50..400 days, GCC 12 -O3): the short
 // path takes every drift there, with one Stumpff evaluation where the general path needs two or three and no
 // square root in its steps; kepler_drift_many runs it on up to eight orbits in lockstep, so that their
@@ -45,6 +51,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "nystrom/core/eft.hpp"
+
 namespace nystrom::planetary {
 
 template <class R>
@@ -56,6 +64,33 @@ struct Stumpff {
 };
 
 namespace detail {
+
+/// x += d, with the carry c of compensated summation when c is given (c == nullptr: plainly).
+template <class R>
+inline void add_increment(R& x, R d, R* c) {
+  if (c == nullptr) {
+    x = x + d;
+    return;
+  }
+  R e;
+  x = eft::two_sum(x, d + *c, e);
+  *c = e;
+}
+
+/// One component of Lagrange's update, x = x0 + (f - 1) x0 + g v0 and v = v0 + fdot x0 + (gdot - 1) v0, plainly
+/// (cx == nullptr) or with compensated summation: the carries ride along the orbit to first order (the increments
+/// of x0 + cx, v0 + cv) and the sums' rounding errors become the new carries.
+template <class R>
+inline void lagrange_update(R& x, R& v, R x0, R v0, R fm1, R g, R fdot, R gdm1, R* cx, R* cv) {
+  if (cx == nullptr) {
+    x = x0 + (fm1 * x0 + g * v0);
+    v = v0 + (fdot * x0 + gdm1 * v0);
+    return;
+  }
+  const R c = *cx, w = *cv;
+  x = eft::two_sum(x0, (fm1 * x0 + g * v0) + ((fm1 * c + g * w) + c), *cx);
+  v = eft::two_sum(v0, (fdot * x0 + gdm1 * v0) + ((fdot * c + gdm1 * w) + w), *cv);
+}
 
 /// Inverse factorials, and for every number of series terms the largest |x| it serves to the working precision.
 template <class R>
@@ -130,7 +165,7 @@ namespace detail {
 
 /// The drift of one orbit by the bracketed Laguerre-Conway iteration (any orbit, any dt; see the top of this file).
 template <class R>
-void kepler_drift_bracketed(R mu, R dt, Vec3<R>& x, Vec3<R>& v) {
+void kepler_drift_bracketed(R mu, R dt, Vec3<R>& x, Vec3<R>& v, R* cx = nullptr, R* cv = nullptr) {
   using std::abs;
   using std::sqrt;
   if (dt == 0) return;
@@ -223,8 +258,7 @@ void kepler_drift_bracketed(R mu, R dt, Vec3<R>& x, Vec3<R>& v) {
   const R gdm1 = -mu * g2 / r;
   const Vec3<R> x0 = x, v0 = v;
   for (int k = 0; k < 3; ++k) {
-    x[k] = x0[k] + (fm1 * x0[k] + g * v0[k]);
-    v[k] = v0[k] + (fdot * x0[k] + gdm1 * v0[k]);
+    lagrange_update(x[k], v[k], x0[k], v0[k], fm1, g, fdot, gdm1, cx ? cx + k : nullptr, cv ? cv + k : nullptr);
   }
 }
 
@@ -235,7 +269,7 @@ inline constexpr std::size_t kKeplerBatch = 8;
 /// mu(k) at x + 3k, v + 3k. The orbits it solves to rounding are advanced and marked done[k]; the others are
 /// left as they were. Each orbit's arithmetic depends on its own data only.
 template <class R, class Mu>
-void kepler_drift_short(std::size_t count, R dt, Mu mu, R* x, R* v, bool* done) {
+void kepler_drift_short(std::size_t count, R dt, Mu mu, R* x, R* v, bool* done, R* cx = nullptr, R* cv = nullptr) {
   using std::abs;
   using std::sqrt;
   const StumpffTable<R>& table = StumpffTable<R>::get();
@@ -306,8 +340,8 @@ void kepler_drift_short(std::size_t count, R dt, Mu mu, R* x, R* v, bool* done) 
     R* vk = v + 3 * k;
     const Vec3<R> x0{xk[0], xk[1], xk[2]}, v0{vk[0], vk[1], vk[2]};
     for (int c = 0; c < 3; ++c) {
-      xk[c] = x0[c] + (fm1 * x0[c] + g * v0[c]);
-      vk[c] = v0[c] + (fdot * x0[c] + gdm1 * v0[c]);
+      lagrange_update(xk[c], vk[c], x0[c], v0[c], fm1, g, fdot, gdm1, cx ? cx + 3 * k + c : nullptr,
+                      cv ? cv + 3 * k + c : nullptr);
     }
   }
 }
@@ -328,20 +362,22 @@ void kepler_drift(R mu, R dt, Vec3<R>& x, Vec3<R>& v) {
 
 /// Advances `count` orbits by the same dt, orbit k of parameter mu(k) at x + 3k and v + 3k (3 components each):
 /// the same result as kepler_drift on each, with the short-drift path run on several orbits together so that
-/// their arithmetic overlaps. Throws as kepler_drift does.
+/// their arithmetic overlaps. With carries cx, cv (laid out as x and v), the increments are added with compensated
+/// summation (top of this file). Throws as kepler_drift does.
 template <class R, class Mu>
-void kepler_drift_many(std::size_t count, R dt, Mu mu, R* x, R* v) {
+void kepler_drift_many(std::size_t count, R dt, Mu mu, R* x, R* v, R* cx = nullptr, R* cv = nullptr) {
   if (dt == 0) return;
   for (std::size_t first = 0; first < count; first += detail::kKeplerBatch) {
     const std::size_t m = std::min(detail::kKeplerBatch, count - first);
     std::array<bool, detail::kKeplerBatch> done{};
     detail::kepler_drift_short<R>(
-        m, dt, [&](std::size_t k) { return mu(first + k); }, x + 3 * first, v + 3 * first, done.data());
+        m, dt, [&](std::size_t k) { return mu(first + k); }, x + 3 * first, v + 3 * first, done.data(),
+        cx ? cx + 3 * first : nullptr, cv ? cv + 3 * first : nullptr);
     for (std::size_t k = 0; k < m; ++k)
       if (!done[k]) {
         const std::size_t i = first + k;
         Vec3<R> xi{x[3 * i], x[3 * i + 1], x[3 * i + 2]}, vi{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-        detail::kepler_drift_bracketed(mu(i), dt, xi, vi);
+        detail::kepler_drift_bracketed(mu(i), dt, xi, vi, cx ? cx + 3 * i : nullptr, cv ? cv + 3 * i : nullptr);
         for (int c = 0; c < 3; ++c) {
           x[3 * i + c] = xi[c];
           v[3 * i + c] = vi[c];

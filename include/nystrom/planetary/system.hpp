@@ -127,13 +127,16 @@ R real_step(std::complex<R> z, const char* what) {
 
 /// The drift of both Wisdom-Holman splittings over a state s (x of n bodies, then v; 3 components each): body 0
 /// (the centre of mass, or the barycentre) moves freely, body i >= 1 follows its Kepler orbit of parameter mu(i).
+/// With carries (laid out as s), every increment is added with compensated summation.
 template <class R, class Mu>
-void kepler_drift_bodies(std::vector<R>& s, std::size_t n, R dt, Mu mu) {
+void kepler_drift_bodies(std::vector<R>& s, std::size_t n, R dt, Mu mu, R* carry = nullptr) {
   R* x = s.data();
   R* v = s.data() + 3 * n;
-  for (int k = 0; k < 3; ++k) x[k] += dt * v[k];
+  for (int k = 0; k < 3; ++k)
+    add_increment(x[k], carry ? dt * v[k] + dt * carry[3 * n + k] : dt * v[k], carry ? carry + k : nullptr);
   kepler_drift_many<R>(
-      n - 1, dt, [&](std::size_t k) { return mu(k + 1); }, x + 3, v + 3);
+      n - 1, dt, [&](std::size_t k) { return mu(k + 1); }, x + 3, v + 3, carry ? carry + 3 : nullptr,
+      carry ? carry + 3 * n + 3 : nullptr);
 }
 
 }  // namespace detail
