@@ -73,24 +73,11 @@ Sample sample(const PlanetarySystem<LD>& sys, const std::vector<Vec3<R>>& x, con
   return s;
 }
 
-template <class R, class From>
-PlanetarySystem<R> cast_system(const PlanetarySystem<From>& d) {
-  PlanetarySystem<R> s;
-  s.G = static_cast<R>(d.G);
-  s.names = d.names;
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    s.mass.push_back(static_cast<R>(d.mass[i]));
-    s.x.push_back({static_cast<R>(d.x[i][0]), static_cast<R>(d.x[i][1]), static_cast<R>(d.x[i][2])});
-    s.v.push_back({static_cast<R>(d.v[i][0]), static_cast<R>(d.v[i][1]), static_cast<R>(d.v[i][2])});
-  }
-  return s;
-}
-
 /// The map over every output (output m after m * kStepsPerOutput steps).
 template <class R>
 std::vector<Sample> run_map(const PlanetarySystem<double>& start, const PlanetarySystem<LD>& sys_ld,
                             const std::vector<long>& outs, long& kicks, Compensation compensated = Compensation::off) {
-  const PlanetarySystem<R> sys = cast_system<R>(start);
+  const PlanetarySystem<R> sys = convert_system<R>(start);
   std::vector<Sample> samples;
   std::vector<Vec3<R>> x, v;
   std::size_t next = 0;
@@ -187,7 +174,7 @@ int main(int argc, char** argv) {
   }
   for (int r = 0; r < realizations; ++r) {
     const PlanetarySystem<double> start = bench::brouwer_start(r);
-    const PlanetarySystem<LD> sys_ld = cast_system<LD>(start);  // the same state, masses and G, exactly
+    const PlanetarySystem<LD> sys_ld = convert_system<LD>(start);  // the same state, masses and G, exactly
     const LD e0 = energy(sys_ld.G, sys_ld.mass, sys_ld.x, sys_ld.v);
     // the reference runs in a second thread while the double runs go on
     std::future<std::vector<Sample>> reference = std::async(std::launch::async, [&] {

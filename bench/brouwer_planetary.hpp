@@ -20,16 +20,8 @@ inline double brouwer_time(long m) { return kBrouwerMapStep * static_cast<double
 /// every realization rounds differently from the first step on (Brouwer's law is a statement about the spread of
 /// such runs; a single run's error wanders).
 inline planetary::PlanetarySystem<double> brouwer_start(int r) {
-  const planetary::PlanetarySystem<long double> b =
-      planetary::barycentric(planetary::outer_solar_system<long double>());
-  planetary::PlanetarySystem<double> s;
-  s.G = static_cast<double>(b.G);
-  s.names = b.names;
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    s.mass.push_back(static_cast<double>(b.mass[i]));
-    s.x.push_back({static_cast<double>(b.x[i][0]), static_cast<double>(b.x[i][1]), static_cast<double>(b.x[i][2])});
-    s.v.push_back({static_cast<double>(b.v[i][0]), static_cast<double>(b.v[i][1]), static_cast<double>(b.v[i][2])});
-  }
+  planetary::PlanetarySystem<double> s =
+      planetary::convert_system<double>(planetary::barycentric(planetary::outer_solar_system<long double>()));
   for (std::size_t i = 1; i < s.size(); ++i)
     for (int k = 0; k < 3; ++k) s.x[i][k] *= 1 + r * std::ldexp(1.0, -50);
   return s;

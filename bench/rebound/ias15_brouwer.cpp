@@ -85,13 +85,7 @@ int main(int argc, char** argv) {
   for (int rz = 0; rz < realizations; ++rz) {
     // the state of bench_brouwer_planetary's realization rz, and its long-double copy for the energy
     const PlanetarySystem<double> start = nystrom::bench::brouwer_start(rz);
-    PlanetarySystem<LD> sys;
-    sys.G = start.G;
-    for (std::size_t i = 0; i < start.size(); ++i) {
-      sys.mass.push_back(start.mass[i]);
-      sys.x.push_back({start.x[i][0], start.x[i][1], start.x[i][2]});
-      sys.v.push_back({start.v[i][0], start.v[i][1], start.v[i][2]});
-    }
+    const PlanetarySystem<LD> sys = convert_system<LD>(start);
     const LD e0 = energy(sys.G, sys.mass, sys.x, sys.v);
     reb_simulation* r = reb_simulation_create();
     reb_simulation_set_integrator(r, "ias15");

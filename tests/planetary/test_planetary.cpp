@@ -763,13 +763,7 @@ TEST(WisdomHolman, CompensatedSplittingLowersTheRoundOff) {
       PlanetarySystem<double> sys = outer_solar_system<double>();
       for (std::size_t i = 1; i < sys.size(); ++i)
         for (int k = 0; k < 3; ++k) sys.x[i][k] *= 1 + r * std::ldexp(1.0, -50);
-      PlanetarySystem<LD> l;
-      l.G = sys.G;
-      for (std::size_t i = 0; i < sys.size(); ++i) {
-        l.mass.push_back(sys.mass[i]);
-        l.x.push_back({sys.x[i][0], sys.x[i][1], sys.x[i][2]});
-        l.v.push_back({sys.v[i][0], sys.v[i][1], sys.v[i][2]});
-      }
+      PlanetarySystem<LD> l = convert_system<LD>(sys);
       const LD e0 = energy(l.G, l.mass, l.x, l.v);
       PropagateOptions<double> opt;
       opt.compensated = c;

@@ -267,6 +267,21 @@ void unflatten(const std::vector<R>& f, std::vector<Vec3<R>>& x) {
     for (int k = 0; k < 3; ++k) x[i][k] = f[3 * i + k];
 }
 
+/// The system in another real type (G, masses, positions and velocities converted one by one): a run in long double
+/// from the very state a double run starts from, or back.
+template <class To, class From>
+PlanetarySystem<To> convert_system(const PlanetarySystem<From>& s) {
+  PlanetarySystem<To> t;
+  t.G = static_cast<To>(s.G);
+  t.names = s.names;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    t.mass.push_back(static_cast<To>(s.mass[i]));
+    t.x.push_back({static_cast<To>(s.x[i][0]), static_cast<To>(s.x[i][1]), static_cast<To>(s.x[i][2])});
+    t.v.push_back({static_cast<To>(s.v[i][0]), static_cast<To>(s.v[i][1]), static_cast<To>(s.v[i][2])});
+  }
+  return t;
+}
+
 /// The position and the velocity of the centre of mass.
 template <class R>
 std::pair<Vec3<R>, Vec3<R>> centre_of_mass(const PlanetarySystem<R>& sys) {
