@@ -738,6 +738,20 @@ TEST(PlanetarySystem, EveryBodyIsValidatedTheCentralOneToo) {
   }
 }
 
+// The observer is called where PropagateOptions says: never while `every` is 0 (the default), even when given;
+// with every = k at step 0, every k steps and after the last step.
+TEST(WisdomHolman, ObserverIsCalledEveryKStepsAndNotByDefault) {
+  const PlanetarySystem<double> sys = two_planets<double>(1e-3);
+  std::vector<long> seen;
+  PropagateOptions<double> opt;
+  opt.observer = [&](long step, const std::vector<double>&) { seen.push_back(step); };
+  (void)propagate(sys, "WH", 0.1, 10, opt);
+  EXPECT_TRUE(seen.empty());
+  opt.every = 4;
+  (void)propagate(sys, "WH", 0.1, 10, opt);
+  EXPECT_EQ(seen, (std::vector<long>{0, 4, 8, 10}));
+}
+
 TEST(WisdomHolman, RefusesComplexAndUnknownMethods) {
   const PlanetarySystem<double> s = two_planets(1e-3);
   EXPECT_THROW((void)propagate(s, "WH-BC1", 0.1, 10), std::invalid_argument);
