@@ -51,7 +51,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "nystrom/core/eft.hpp"
+#include "nystrom/core/state.hpp"  // compensated_add
 
 namespace nystrom::planetary {
 
@@ -68,13 +68,10 @@ namespace detail {
 /// x += d, with the carry c of compensated summation when c is given (c == nullptr: plainly).
 template <class R>
 inline void add_increment(R& x, R d, R* c) {
-  if (c == nullptr) {
+  if (c == nullptr)
     x = x + d;
-    return;
-  }
-  R e;
-  x = eft::two_sum(x, d + *c, e);
-  *c = e;
+  else
+    compensated_add(x, *c, d);
 }
 
 /// One component of Lagrange's update, x = x0 + (f - 1) x0 + g v0 and v = v0 + fdot x0 + (gdot - 1) v0, plainly
@@ -88,8 +85,12 @@ inline void lagrange_update(R& x, R& v, R x0, R v0, R fm1, R g, R fdot, R gdm1, 
     return;
   }
   const R c = *cx, w = *cv;
-  x = eft::two_sum(x0, (fm1 * x0 + g * v0) + ((fm1 * c + g * w) + c), *cx);
-  v = eft::two_sum(v0, (fdot * x0 + gdm1 * v0) + ((fdot * c + gdm1 * w) + w), *cv);
+  *cx = (fm1 * c + g * w) + c;  // the carries after the drift, before the sums' rounding joins them
+  *cv = (fdot * c + gdm1 * w) + w;
+  x = x0;
+  v = v0;
+  compensated_add(x, *cx, fm1 * x0 + g * v0);
+  compensated_add(v, *cv, fdot * x0 + gdm1 * v0);
 }
 
 /// Inverse factorials, and for every number of series terms the largest |x| it serves to the working precision.

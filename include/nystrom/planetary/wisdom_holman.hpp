@@ -235,7 +235,7 @@ struct PropagateOptions {
   /// Compensated summation of the drifts' and kicks' increments (JacobiFlows::set_compensated) for the splittings in
   /// Jacobi coordinates (the expansions and the democratic heliocentric maps add plainly): off by default; on (or
   /// automatic: on in double and float) removes the random walk of the state's rounding, 8x lower energy errors
-  /// over 1e3 Jupiter periods for SABA(10,6,4) on the outer solar system, at about 1.16x the cost per step. Over
+  /// over 1e3 Jupiter periods for SABA(10,6,4) on the outer solar system, at about 1.15x the cost per step. Over
   /// 1e5 periods and more the Kepler solver's own energy bias (about -7e-20 per drift, the same sign every time)
   /// catches up with the plain map's random walk (docs/performance.md, "Long runs").
   Compensation compensated = Compensation::off;
