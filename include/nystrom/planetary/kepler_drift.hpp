@@ -51,7 +51,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "nystrom/core/state.hpp"  // compensated_add
+#include "nystrom/core/eft.hpp"
 
 namespace nystrom::planetary {
 
@@ -68,10 +68,13 @@ namespace detail {
 /// x += d, with the carry c of compensated summation when c is given (c == nullptr: plainly).
 template <class R>
 inline void add_increment(R& x, R d, R* c) {
-  if (c == nullptr)
+  if (c == nullptr) {
     x = x + d;
-  else
-    compensated_add(x, *c, d);
+    return;
+  }
+  R e;
+  x = eft::two_sum(x, d + *c, e);
+  *c = e;
 }
 
 /// One component of Lagrange's update, x = x0 + (f - 1) x0 + g v0 and v = v0 + fdot x0 + (gdot - 1) v0, plainly
@@ -85,12 +88,8 @@ inline void lagrange_update(R& x, R& v, R x0, R v0, R fm1, R g, R fdot, R gdm1, 
     return;
   }
   const R c = *cx, w = *cv;
-  *cx = (fm1 * c + g * w) + c;  // the carries after the drift, before the sums' rounding joins them
-  *cv = (fdot * c + gdm1 * w) + w;
-  x = x0;
-  v = v0;
-  compensated_add(x, *cx, fm1 * x0 + g * v0);
-  compensated_add(v, *cv, fdot * x0 + gdm1 * v0);
+  x = eft::two_sum(x0, (fm1 * x0 + g * v0) + ((fm1 * c + g * w) + c), *cx);
+  v = eft::two_sum(v0, (fdot * x0 + gdm1 * v0) + ((fdot * c + gdm1 * w) + w), *cv);
 }
 
 /// Inverse factorials, and for every number of series terms the largest |x| it serves to the working precision.

@@ -204,44 +204,41 @@ Vec3<R> angular_momentum(const std::vector<R>& mass, const std::vector<Vec3<R>>&
   return l;
 }
 
-namespace detail {
-
-/// The pair loop of the Newtonian accelerations over any layout: x(i, k) reads coordinate k of body i, a(i, k) is
-/// the accumulator of its acceleration (zeroed by the caller).
-template <class R, class X, class A>
-void newton_pairs(R G, const std::vector<R>& mass, X x, A a) {
+/// Newtonian accelerations a_i = sum_{j != i} G m_j (x_j - x_i) / r_ij^3.
+template <class R>
+void accelerations(R G, const std::vector<R>& mass, const std::vector<Vec3<R>>& x, std::vector<Vec3<R>>& a) {
   using std::sqrt;
   const std::size_t n = mass.size();
+  a.assign(n, Vec3<R>{0, 0, 0});
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = i + 1; j < n; ++j) {
-      const R d[3] = {x(j, 0) - x(i, 0), x(j, 1) - x(i, 1), x(j, 2) - x(i, 2)};
+      const Vec3<R> d{x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
       const R r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
       const R inv3 = G / (r2 * sqrt(r2));
       for (int k = 0; k < 3; ++k) {
-        a(i, k) += mass[j] * inv3 * d[k];
-        a(j, k) -= mass[i] * inv3 * d[k];
+        a[i][k] += mass[j] * inv3 * d[k];
+        a[j][k] -= mass[i] * inv3 * d[k];
       }
     }
 }
 
-}  // namespace detail
-
-/// Newtonian accelerations a_i = sum_{j != i} G m_j (x_j - x_i) / r_ij^3.
-template <class R>
-void accelerations(R G, const std::vector<R>& mass, const std::vector<Vec3<R>>& x, std::vector<Vec3<R>>& a) {
-  a.assign(mass.size(), Vec3<R>{0, 0, 0});
-  detail::newton_pairs(
-      G, mass, [&](std::size_t i, int k) { return x[i][k]; }, [&](std::size_t i, int k) -> R& { return a[i][k]; });
-}
-
 /// The same accelerations on the flat Cartesian state of the catalog's direct methods (body i at 3i, 3i + 1,
-/// 3i + 2), bitwise the values of accelerations().
+/// 3i + 2): the same operations in the same order as accelerations(), so bitwise the same values.
 template <class R>
 void flat_accelerations(R G, const std::vector<R>& mass, const std::vector<R>& q, std::vector<R>& a) {
-  a.assign(3 * mass.size(), R(0));
-  detail::newton_pairs(
-      G, mass, [&](std::size_t i, int k) { return q[3 * i + k]; },
-      [&](std::size_t i, int k) -> R& { return a[3 * i + k]; });
+  using std::sqrt;
+  const std::size_t n = mass.size();
+  a.assign(3 * n, R(0));
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const R d[3] = {q[3 * j] - q[3 * i], q[3 * j + 1] - q[3 * i + 1], q[3 * j + 2] - q[3 * i + 2]};
+      const R r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      const R inv3 = G / (r2 * sqrt(r2));
+      for (int k = 0; k < 3; ++k) {
+        a[3 * i + k] += mass[j] * inv3 * d[k];
+        a[3 * j + k] -= mass[i] * inv3 * d[k];
+      }
+    }
 }
 
 /// A system's Newtonian force as a force functor of solve() and the integrators, on the flat state (flatten()).
