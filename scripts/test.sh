@@ -19,10 +19,11 @@ bash scripts/check-layers.sh
 
 echo "== Release build (warnings as errors): the tool's, Python and install tests at the shipped optimisation level"
 # Debian's python3 (numpy, pybind11): a python3 earlier on PATH may lack them.
-# test_discover, a library test program, is built here too: its two method searches take 1-2 s each in Release and
-# 30-90 s each under the sanitizers at -O0 (its other tests, which reach the same search code, run there as well).
+# test_discover and test_splitting_law, library test programs, are built here too: test_discover's two method
+# searches take 1-2 s each in Release and 30-90 s each under the sanitizers at -O0 (its other tests, which reach the
+# same search code, run there as well); likewise test_splitting_law's double-well orders (4-5 s in Release).
 cmake --preset release -DNYSTROM_BUILD_TESTS=ON -DNYSTROM_BUILD_BENCH=OFF -DNYSTROM_TEST_SCOPE=cli \
-  -DNYSTROM_TEST_EXTRA=test_discover -DNYSTROM_BUILD_PYTHON=ON -DPython3_EXECUTABLE=/usr/bin/python3 \
+  "-DNYSTROM_TEST_EXTRA=test_discover;test_splitting_law" -DNYSTROM_BUILD_PYTHON=ON -DPython3_EXECUTABLE=/usr/bin/python3 \
   -DCMAKE_CXX_FLAGS="-Werror" >/dev/null
 cmake --build --preset release -j "$jobs"
 ctest --preset release -j "$jobs"
@@ -38,10 +39,11 @@ cmake --build --preset asan-fuzz -j "$jobs"
 # of the adaptive engines (the rounding of GCC's -O3 build is the one they assert, and at -O0 they take minutes),
 # the quick reproduction of both papers (5 s in Release, about 290 s at -O0 under the sanitizers), and the
 # tool's method search and Langevin contract runs (about 1 s each in Release, 14-47 s each here: numerical work
-# whose tool code the other command-line tests and fuzz_cli cover under the sanitizers), and test_discover's two
-# searches (above).
+# whose tool code the other command-line tests and fuzz_cli cover under the sanitizers), test_discover's two
+# searches (above), and the double-well runs of the Langevin scheme's law on a phase-space grid (2-5 s each in
+# Release, minutes here; its harmonic and refusal tests run here).
 ctest --preset asan-fuzz -j "$jobs" \
-  -E '^(test_bench_peers|AdaptiveFloorCli\..*|Reproduce\.AllQuick.*|BchCli\.SixStageFromPublishedMethod|BchCli\.DiscoverWritesMethodsThatRun|LangevinCli\.ContractJsonAgreesWithTheBoltzmannDensityForAnyThreadCount|Discover\.SmallSeededSearchFindsAR1AndAC1|Discover\.SixStageSearchFromAC1ReachesThePublishedLevel)$'
+  -E '^(test_bench_peers|AdaptiveFloorCli\..*|Reproduce\.AllQuick.*|BchCli\.SixStageFromPublishedMethod|BchCli\.DiscoverWritesMethodsThatRun|LangevinCli\.ContractJsonAgreesWithTheBoltzmannDensityForAnyThreadCount|Discover\.SmallSeededSearchFindsAR1AndAC1|Discover\.SixStageSearchFromAC1ReachesThePublishedLevel|SplittingLaw\.DoubleWellWeakOrdersTwoFourAndSix|LangevinCli\.StationaryLawIsExactWithoutPaths)$'
 echo "   ($(( $(date +%s) - start )) s so far)"
 
 echo "== Mutation sample: 3 mechanically generated mutants (scripts/mutants.py, seed 35), about 3 minutes"

@@ -5,6 +5,10 @@
 // averages of q, q^2, q^4, v^2 and the energy over the paths, as time averages over the second half of the run
 // ("averages") and at the end ("final"), with standard errors, extrapolated with the multi-product sequence
 // given. The numbers do not depend on --threads.
+//
+// `nystrom langevin --stationary-law [--grid-points 65] ...` computes instead the scheme's stationary averages and
+// those of its extrapolation exactly, from the scheme's law on a phase-space grid
+// (include/nystrom/stochastic/splitting_law.hpp): no paths, no statistical error.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,6 +23,7 @@
 
 #include "cli.hpp"
 #include "nystrom/stochastic/potentials.hpp"
+#include "nystrom/stochastic/splitting_law.hpp"
 #include "progress.hpp"
 
 namespace {
@@ -36,6 +41,8 @@ struct Options {
   std::string extrapolate = "1";
   int threads = 0;
   bool json = false;
+  bool stationary_law = false;
+  int grid_points = 65;
 };
 
 int thread_count(int t) {
@@ -80,6 +87,66 @@ nlohmann::json to_json(const Options& o, const st::LangevinResult& r) {
   return j;
 }
 
+nlohmann::json law_to_json(const Options& o, const st::StationaryLawResult& r) {
+  nlohmann::json j;
+  j["problem"] = {{"potential", o.potential}, {"gamma", o.gamma}, {"kT", o.kT}, {"mass", 1.0}};
+  if (o.potential == "harmonic") j["problem"]["omega"] = o.omega;
+  j["method"] = r.method;
+  j["h"] = r.h;
+  j["extrapolate"] = r.extrapolate;
+  j["coefficients"] = r.coefficients;
+  j["order"] = r.order;
+  auto& avg = j["stationary"] = nlohmann::json::object();
+  auto& boltzmann = j["boltzmann"] = nlohmann::json::object();
+  for (std::size_t b = 0; b < r.observable_names.size(); ++b) {
+    avg[r.observable_names[b]] = r.averages[b];
+    boltzmann[r.observable_names[b]] = r.boltzmann[b];
+  }
+  auto& members = j["members"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.extrapolate.size(); ++i) {
+    nlohmann::json m{
+        {"k", r.extrapolate[i]}, {"h", r.h / static_cast<double>(r.extrapolate[i])}, {"steps", r.steps[i]}};
+    for (std::size_t b = 0; b < r.observable_names.size(); ++b)
+      m["stationary"][r.observable_names[b]] = r.members[i][b];
+    members.push_back(std::move(m));
+  }
+  j["grid"] = {{"points", {r.grid.nq, r.grid.nv}}, {"q", {r.grid.q_min, r.grid.q_max}}, {"v_max", r.grid.v_max}};
+  j["resolution"] = r.resolution;
+  j["edge"] = r.edge;
+  return j;
+}
+
+int run_stationary_law(const Options& o, const std::vector<long>& extrapolate) {
+  if (o.grid_points < 9 || o.grid_points > 257 || o.grid_points % 2 == 0)
+    throw UsageError("--grid-points must be odd, 9 to 257, got " + std::to_string(o.grid_points));
+  const auto problem = st::builtin_problem_1d(o.potential, o.gamma, o.kT, 1.0, o.q0, o.v0, o.omega);
+  st::StationaryLawOptions opt;
+  opt.method = o.method;
+  opt.h = o.h;
+  opt.extrapolate = extrapolate;
+  opt.grid.nq = opt.grid.nv = o.grid_points;
+  nystrom::cli::Progress progress("stationary law (members)", static_cast<long>(extrapolate.size()));
+  opt.progress = [&progress](std::size_t done, std::size_t) { progress.tick(static_cast<long>(done)); };
+  const st::StationaryLawResult r = st::stationary_law(problem, opt);
+  if (o.json) {
+    std::cout << law_to_json(o, r).dump(2) << "\n";
+    return 0;
+  }
+  std::string seq;
+  for (long k : r.extrapolate) seq += (seq.empty() ? "" : ",") + std::to_string(k);
+  fmt::print("problem        {} (gamma {}, kT {})\n", o.potential, o.gamma, o.kT);
+  fmt::print("method         {}, h {}, extrapolated with {} (weak order {})\n", r.method, r.h, seq, r.order);
+  fmt::print("stationary law on a {} x {} grid, q in [{:.4g}, {:.4g}), |v| < {:.4g}; steps to the fixed point:",
+             r.grid.nq, r.grid.nv, r.grid.q_min, r.grid.q_max, r.grid.v_max);
+  for (long n : r.steps) fmt::print(" {}", n);
+  fmt::print("\nresolution     {:.1e} (spectrum's outer quarter), edge {:.1e}\n", r.resolution, r.edge);
+  fmt::print("{:<8} {:>20} {:>20} {:>12}\n", "", "stationary", "Boltzmann", "bias");
+  for (std::size_t b = 0; b < r.observable_names.size(); ++b)
+    fmt::print("{:<8} {:>20.15f} {:>20.15f} {:>+12.3e}\n", r.observable_names[b], r.averages[b], r.boltzmann[b],
+               r.averages[b] - r.boltzmann[b]);
+  return 0;
+}
+
 nystrom::cli::Registrar reg(
     "langevin", "Langevin dynamics: averages over paths by BAOAB-type splittings, with extrapolation",
     [](CLI::App& app) {
@@ -95,15 +162,28 @@ nystrom::cli::Registrar reg(
                      "Splitting over A (drift), B (kick), O (Ornstein-Uhlenbeck): BAOAB, OBABO, ABOBA, ...")
           ->capture_default_str();
       app.add_option("--h", o->h, "Step")->capture_default_str();
-      app.add_option("--t-end", o->t_end, "End time T (a whole number of steps)")->capture_default_str();
-      app.add_option("--paths", o->paths, "Independent paths")->capture_default_str();
-      app.add_option("--seed", o->seed, "Seed of the counter-based generator (Philox)")->capture_default_str();
+      auto* t_end = app.add_option("--t-end", o->t_end, "End time T (a whole number of steps)")->capture_default_str();
+      auto* paths = app.add_option("--paths", o->paths, "Independent paths")->capture_default_str();
+      auto* seed =
+          app.add_option("--seed", o->seed, "Seed of the counter-based generator (Philox)")->capture_default_str();
       app.add_option("--extrapolate", o->extrapolate,
                      "Multi-product sequence k_1,...,k_n: runs at h / k_i combined (1: the scheme alone)")
           ->capture_default_str();
-      app.add_option("--threads", o->threads, "Threads (0: all cores); the results do not depend on it")
-          ->capture_default_str();
+      auto* threads = app.add_option("--threads", o->threads, "Threads (0: all cores); the results do not depend on it")
+                          ->capture_default_str();
       app.add_flag("--json", o->json, "Print one JSON object");
+      auto* law =
+          app.add_flag(
+                 "--stationary-law", o->stationary_law,
+                 "No paths: the exact stationary averages of the scheme (and of its extrapolation) from its law on a "
+                 "phase-space grid")
+              ->excludes(t_end)
+              ->excludes(paths)
+              ->excludes(seed)
+              ->excludes(threads);
+      app.add_option("--grid-points", o->grid_points, "--stationary-law: grid points per axis (odd, 9..257)")
+          ->capture_default_str()
+          ->needs(law);
       return [o]() {
         const auto positive = [](double x, const char* what) {
           if (!(x > 0)) throw UsageError(fmt::format("{} must be positive, got {}", what, x));
@@ -116,6 +196,13 @@ nystrom::cli::Registrar reg(
         non_negative(o->gamma, "--gamma");
         non_negative(o->kT, "--kT");
         positive(o->h, "--h");
+        std::vector<long> sequence;
+        try {
+          sequence = nystrom::parse_sequence(o->extrapolate);
+        } catch (const std::invalid_argument& e) {
+          throw UsageError(std::string("--extrapolate: ") + e.what());
+        }
+        if (o->stationary_law) return run_stationary_law(*o, sequence);
         positive(o->t_end, "--t-end");
         if (o->paths < 1) throw UsageError("--paths must be positive, got " + std::to_string(o->paths));
         if (o->threads < 0) throw UsageError("--threads must not be negative");
@@ -124,11 +211,7 @@ nystrom::cli::Registrar reg(
         opt.h = o->h;
         opt.paths = o->paths;
         opt.seed = o->seed;
-        try {
-          opt.extrapolate = nystrom::parse_sequence(o->extrapolate);
-        } catch (const std::invalid_argument& e) {
-          throw UsageError(std::string("--extrapolate: ") + e.what());
-        }
+        opt.extrapolate = sequence;
         opt.threads = thread_count(o->threads);
         const auto problem = st::builtin_problem_1d(o->potential, o->gamma, o->kT, o->t_end, o->q0, o->v0, o->omega);
         double members = 0;

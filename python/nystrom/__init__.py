@@ -9,7 +9,8 @@ extrapolation for velocity-dependent forces q'' = a(t, q, v) and first-order sys
 
 Built-in problems (``nystrom.problems``), the exact velocity-dependent flows (``nystrom.flows``: a rotating
 frame, a magnetic field, friction), the split-operator Schrödinger solver (``nystrom.quantum``), diffusion
-(``nystrom.smoluchowski``, ``nystrom.thermal``) and Langevin path ensembles (``nystrom.langevin``) run in C++
+(``nystrom.smoluchowski``, ``nystrom.thermal``), Langevin path ensembles (``nystrom.langevin``) and the exact
+stationary law of a Langevin splitting (``nystrom.stationary_law``) run in C++
 with the GIL released; ``nystrom.ensemble`` maps runs over a process pool, a Dask client or an MPI pool;
 ``nystrom.plot`` draws orbits, energy errors and work-precision charts.
 """
@@ -23,7 +24,7 @@ from ._first_order import FirstOrderResult, solve_ivp
 from ._flows import FlowResult, damped, flows, magnetic, rotating_frame
 from ._quantum import QuantumResult, quantum
 from ._diffusion import SmoluchowskiResult, ThermalResult, smoluchowski, thermal
-from ._langevin import LangevinResult, langevin
+from ._langevin import LangevinResult, StationaryLawResult, langevin, stationary_law
 from .ensemble import ensemble
 from . import problems
 
@@ -32,7 +33,7 @@ __version__ = _core.__version__  # the CMake project version, as `nystrom --vers
 __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "solve_ivp", "OdeResult", "FirstOrderResult",
            "DenseSolution", "quantum", "QuantumResult", "smoluchowski", "SmoluchowskiResult", "thermal", "ThermalResult",
            "flows", "rotating_frame", "magnetic", "damped", "FlowResult",
-           "langevin", "LangevinResult", "problems", "ensemble", "plot"]
+           "langevin", "LangevinResult", "stationary_law", "StationaryLawResult", "problems", "ensemble", "plot"]
 
 
 def methods():

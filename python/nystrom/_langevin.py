@@ -19,7 +19,7 @@ from . import _core
 from ._progress import counted_progress
 from ._result import AttrDict
 
-__all__ = ["langevin", "LangevinResult"]
+__all__ = ["langevin", "LangevinResult", "stationary_law", "StationaryLawResult"]
 
 
 class LangevinResult(AttrDict):
@@ -174,3 +174,49 @@ def langevin(potential="harmonic", gamma=1.0, kT=1.0, method="BAOAB", h=0.05, t_
         if close is not None:
             close(done)
     return LangevinResult(d)
+
+
+class StationaryLawResult(AttrDict):
+    """The result of :func:`nystrom.stationary_law` (a dict whose keys are also attributes).
+
+    Attributes: ``stationary`` (a dict mapping the observables ``q``, ``q2``, ``q4``, ``v2``, ``energy`` to the
+    combination's stationary average), ``boltzmann`` (the exact Boltzmann averages by the same quadrature),
+    ``members`` (one dict per k_i: ``k``, ``h`` = h / k_i, ``steps`` to the fixed point, its own ``stationary``),
+    ``coefficients`` (c_i), ``order``, ``method``, ``h``, ``extrapolate``, ``grid`` (``points``, ``q`` range,
+    ``v_max``), ``resolution`` (fraction of the densities' spectrum in the outer quarter of the wave numbers) and
+    ``edge`` (largest density on the grid's edges relative to its maximum).
+    """
+
+    def __repr__(self):
+        q2 = self.stationary["q2"]
+        return (f"StationaryLawResult(method={self.method!r}, h={self.h!r}, extrapolate={self.extrapolate!r}, "
+                f"q2={q2!r}, bias={q2 - self.boltzmann['q2']!r})")
+
+
+def stationary_law(potential="harmonic", gamma=1.0, kT=1.0, method="BAOAB", h=0.05, extrapolate=(1,), q0=1.0,
+                   omega=1.0, grid_points=65):
+    """The exact stationary averages of a Langevin splitting at the steps h / k_i and of their multi-product
+    combination, from the scheme's law on a phase-space grid: no paths, no statistical error (as ``nystrom
+    langevin --stationary-law``, with the same defaults; docs/stochastic.md).
+
+    The density of (q, v) is carried by the splitting's own flows, each exact on the grid's trigonometric
+    polynomials (drift and kick: band-limited shifts; O: the Ornstein-Uhlenbeck transition kernel), and iterated
+    from the Boltzmann density to the scheme's fixed point. ``potential``, ``gamma``, ``kT``, ``method``, ``h``,
+    ``extrapolate``, ``omega`` are those of :func:`nystrom.langevin` (gamma and kT must be positive); ``q0`` is
+    where the search for the grid's q range starts (where the Boltzmann density exceeds e^-40 of its maximum);
+    ``grid_points`` (odd, 9..257) per axis. A density that reaches the grid's edges or is not resolved by it (a
+    step near the scheme's stability bound) is refused with RuntimeError.
+
+    >>> import nystrom
+    >>> r = nystrom.stationary_law("harmonic", h=1.0)  # BAOAB: <q^2> exact, <v^2> = kT (1 - h^2 / 4)
+    >>> round(r.stationary["q2"], 10), round(r.stationary["v2"], 10)
+    (1.0, 0.75)
+    """
+    for name, value in (("potential", potential), ("method", method)):
+        if not isinstance(value, str):
+            raise TypeError(f"{name} must be a string, got {type(value).__name__}")
+    gamma, kT, h, q0, omega = (_real(n, v) for n, v in (("gamma", gamma), ("kT", kT), ("h", h), ("q0", q0),
+                                                         ("omega", omega)))
+    grid_points = _integer("grid_points", grid_points, 9, 257)
+    seq = _sequence(extrapolate)
+    return StationaryLawResult(_core.stationary_law(potential, omega, gamma, kT, q0, method, h, seq, grid_points))

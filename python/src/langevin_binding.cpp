@@ -14,6 +14,7 @@
 
 #include "langevin_binding.hpp"
 #include "nystrom/stochastic/potentials.hpp"
+#include "nystrom/stochastic/splitting_law.hpp"
 
 namespace nystrom::python {
 
@@ -171,6 +172,55 @@ py::dict langevin_finish(const Request& q, const py::list& parts) {
   return result_dict(st::finish_langevin(problem, q.options(), all), q.seed);
 }
 
+// The stationary law of a built-in problem's splitting on a phase-space grid (the keys of `nystrom langevin
+// --stationary-law --json`).
+py::dict stationary_law(const std::string& potential, double omega, double gamma, double kT, double q0,
+                        const std::string& method, double h, const std::vector<long>& extrapolate, int grid_points) {
+  if (grid_points < 9 || grid_points > 257 || grid_points % 2 == 0)
+    throw invalid_input("grid_points must be odd, 9 to 257, got " + std::to_string(grid_points));
+  const auto problem = st::builtin_problem_1d(potential, gamma, kT, 1.0, q0, 0.0, omega);
+  st::StationaryLawOptions o;
+  o.method = method;
+  o.h = h;
+  o.extrapolate = extrapolate;
+  o.grid.nq = o.grid.nv = grid_points;
+  st::StationaryLawResult r;
+  {
+    py::gil_scoped_release free;
+    r = st::stationary_law(problem, o);
+  }
+  py::dict d, avg, boltzmann, grid;
+  for (std::size_t b = 0; b < r.observable_names.size(); ++b) {
+    avg[py::str(r.observable_names[b])] = r.averages[b];
+    boltzmann[py::str(r.observable_names[b])] = r.boltzmann[b];
+  }
+  py::list members;
+  for (std::size_t i = 0; i < r.extrapolate.size(); ++i) {
+    py::dict m, ma;
+    m["k"] = r.extrapolate[i];
+    m["h"] = r.h / static_cast<double>(r.extrapolate[i]);
+    m["steps"] = r.steps[i];
+    for (std::size_t b = 0; b < r.observable_names.size(); ++b) ma[py::str(r.observable_names[b])] = r.members[i][b];
+    m["stationary"] = ma;
+    members.append(m);
+  }
+  grid["points"] = py::make_tuple(r.grid.nq, r.grid.nv);
+  grid["q"] = py::make_tuple(r.grid.q_min, r.grid.q_max);
+  grid["v_max"] = r.grid.v_max;
+  d["method"] = r.method;
+  d["h"] = r.h;
+  d["extrapolate"] = r.extrapolate;
+  d["coefficients"] = r.coefficients;
+  d["order"] = r.order;
+  d["stationary"] = avg;
+  d["boltzmann"] = boltzmann;
+  d["members"] = members;
+  d["grid"] = grid;
+  d["resolution"] = r.resolution;
+  d["edge"] = r.edge;
+  return d;
+}
+
 }  // namespace
 
 void register_langevin(py::module_& m) {
@@ -188,6 +238,10 @@ void register_langevin(py::module_& m) {
   m.def("langevin_partial", &langevin_partial, py::arg("request"), py::arg("first_path"), py::arg("count"),
         "The statistics of the paths first_path .. first_path + count - 1 (first_path a multiple of 64) as plain, "
         "picklable data for langevin_finish");
+  m.def("stationary_law", &stationary_law, py::arg("potential"), py::arg("omega"), py::arg("gamma"), py::arg("kT"),
+        py::arg("q0"), py::arg("method"), py::arg("h"), py::arg("extrapolate"), py::arg("grid_points"),
+        "The exact stationary averages of a splitting and its extrapolation from its law on a phase-space grid "
+        "(nystrom.stationary_law checks the arguments and wraps the result)");
   m.def("langevin_finish", &langevin_finish, py::arg("request"), py::arg("parts"),
         "Merges partial results (in path order) into the result of nystrom.langevin");
 }

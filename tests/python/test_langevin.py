@@ -94,3 +94,39 @@ def test_progress_reports_the_paths():
     seen = []
     nystrom.langevin(paths=200, t_end=1.0, progress=lambda done, total: seen.append((done, total)))
     assert seen and seen[-1] == (200, 200)
+
+
+def test_stationary_law_is_the_tools_and_exact_for_the_harmonic_oscillator():
+    kT, omega, h = 0.5, 2.0, 0.5  # h omega = 1: BAOAB's <q^2> = kT / omega^2, <v^2> = kT (1 - 1/4)
+    r = nystrom.stationary_law("harmonic", kT=kT, omega=omega, h=h, extrapolate=[1, 2])
+    assert r.members[0]["stationary"]["q2"] == pytest.approx(kT / omega**2, abs=1e-11)
+    assert r.members[0]["stationary"]["v2"] == pytest.approx(kT * 0.75, abs=1e-11)
+    assert r.stationary["v2"] == pytest.approx(kT, abs=1e-11)  # the h^2 term is all of <v^2>'s bias
+    assert r.boltzmann["q2"] == pytest.approx(kT / omega**2, abs=1e-12)
+    assert r.order == 4 and r.grid["points"] == (65, 65)
+    assert r.resolution < 1e-6 and r.edge < 1e-6
+    # the tool's --stationary-law gives the same numbers (shortest round-trip JSON of the same doubles)
+    import json
+    import os
+    import subprocess
+    tool = os.environ.get("NYSTROM_BIN")
+    if tool:
+        out = subprocess.run([tool, "langevin", "--stationary-law", "--potential", "harmonic", "--kT", "0.5",
+                              "--omega", "2", "--h", "0.5", "--extrapolate", "1,2", "--json"],
+                             check=True, capture_output=True, text=True).stdout
+        assert json.loads(out)["stationary"] == r.stationary
+
+
+def test_stationary_law_refusals():
+    with pytest.raises(ValueError, match="symmetric"):
+        nystrom.stationary_law(method="BAO", extrapolate=[1, 2])
+    with pytest.raises(ValueError, match="friction"):
+        nystrom.stationary_law(gamma=0.0)
+    with pytest.raises(ValueError, match="grid_points"):
+        nystrom.stationary_law(grid_points=64)
+    with pytest.raises(ValueError, match="between 9 and 257"):
+        nystrom.stationary_law(grid_points=1001)
+    with pytest.raises(TypeError):
+        nystrom.stationary_law(h="0.1")
+    with pytest.raises(RuntimeError, match="grid"):
+        nystrom.stationary_law("double-well", kT=0.5, h=0.4)

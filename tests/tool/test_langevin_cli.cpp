@@ -102,3 +102,63 @@ TEST(LangevinCli, BadInputIsOneLineAndExitTwo) {
     EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
   }
 }
+
+// --stationary-law: the exact stationary averages of the scheme from its law on a phase-space grid. BAOAB at
+// h omega = 1 samples q exactly (<q^2> = kT / omega^2) and <v^2> = kT (1 - h^2 omega^2 / 4); in the double well
+// the three-term extrapolation's bias at h = 0.1 is below 1e-8 while BAOAB's own (its first member) is 2e-4, both
+// against Simpson's rule for the Boltzmann density, which the reported "boltzmann" matches.
+TEST(LangevinCli, StationaryLawIsExactWithoutPaths) {
+  const auto r = run("langevin --stationary-law --potential harmonic --kT 0.5 --omega 2 --h 0.5 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j.at("stationary").at("q2").get<double>(), 0.5 / 4, 1e-11);
+  EXPECT_NEAR(j.at("stationary").at("v2").get<double>(), 0.5 * (1 - 0.25), 1e-11);
+  EXPECT_NEAR(j.at("boltzmann").at("v2").get<double>(), 0.5, 1e-12);
+  EXPECT_EQ(j.at("order").get<int>(), 2);
+  EXPECT_LT(j.at("resolution").get<double>(), 1e-6);
+  EXPECT_LT(j.at("edge").get<double>(), 1e-6);
+  EXPECT_EQ(j.at("grid").at("points"), nlohmann::json({65, 65}));
+
+  const auto w =
+      run("langevin --stationary-law --potential double-well --gamma 1 --kT 0.5 --h 0.1 --extrapolate "
+          "1,2,3 --json");
+  ASSERT_EQ(w.code, 0) << w.err;
+  const auto d = nlohmann::json::parse(w.out);
+  const auto [m2, m4] = boltzmann_moments(0.5);
+  EXPECT_NEAR(d.at("boltzmann").at("q2").get<double>(), m2, 1e-12);
+  EXPECT_NEAR(d.at("boltzmann").at("q4").get<double>(), m4, 1e-12);
+  EXPECT_LT(std::abs(d.at("stationary").at("q2").get<double>() - m2), 1e-8);
+  EXPECT_LT(std::abs(d.at("stationary").at("q4").get<double>() - m4), 1e-8);
+  const auto& members = d.at("members");
+  ASSERT_EQ(members.size(), 3u);
+  EXPECT_GT(std::abs(members[0].at("stationary").at("q2").get<double>() - m2), 1.5e-4);
+  EXPECT_EQ(members[2].at("h").get<double>(), 0.1 / 3);
+  EXPECT_GT(members[2].at("steps").get<long>(), 0);
+  EXPECT_EQ(d.at("order").get<int>(), 6);
+
+  const auto text = run("langevin --stationary-law --h 0.5");
+  ASSERT_EQ(text.code, 0) << text.err;
+  for (const char* s : {"stationary", "Boltzmann", "bias", "q2", "65 x 65"})
+    EXPECT_NE(text.out.find(s), std::string::npos) << s << "\n" << text.out;
+}
+
+TEST(LangevinCli, StationaryLawRefusalsAreOneLineAndExitTwo) {
+  for (const char* args : {
+           "langevin --stationary-law --paths 10",
+           "langevin --stationary-law --seed 3",
+           "langevin --stationary-law --t-end 5",
+           "langevin --grid-points 33",
+           "langevin --stationary-law --grid-points 64",
+           "langevin --stationary-law --grid-points 1001",
+           "langevin --stationary-law --gamma 0",
+           "langevin --stationary-law --kT 0",
+           "langevin --stationary-law --method BAO --extrapolate 1,2",
+           "langevin --stationary-law --potential double-well --kT 0.5 --h 0.4",
+       }) {
+    const auto r = run(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out << r.err;
+    EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << args << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+  }
+}
