@@ -13,10 +13,13 @@
 // is not included: the coupled runs of an extrapolation have 1.35 (1,2) and 2.3 (1,2,3) times the variance of BAOAB's
 // (bench_langevin). A plain program (no Google Benchmark harness).
 //
-//   bench_langevin_law [POINTS]     (grid points per axis, odd; default 65)
+//   bench_langevin_law [POINTS [CSV]]     (grid points per axis, odd, default 65; CSV: the scan's rows, one per
+//                                          h and method: h,method,forces_per_time,bias_q2,bias_q4, for
+//                                          bench/langevin_law_plot.py; written to a temporary file and renamed)
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -70,10 +73,11 @@ bool within(const Biases& b, int n, double target) {
 
 int main(int argc, char** argv) {
   const int points = argc > 1 ? std::atoi(argv[1]) : 65;
-  if (points < 9 || points > 1025 || points % 2 == 0) {
-    std::fprintf(stderr, "usage: bench_langevin_law [POINTS: odd, 9..1025]\n");
+  if (points < 9 || points > 1025 || points % 2 == 0 || argc > 3) {
+    std::fprintf(stderr, "usage: bench_langevin_law [POINTS: odd, 9..1025 [CSV]]\n");
     return 2;
   }
+  const std::string csv = argc > 2 ? argv[2] : "";
   const auto p = st::builtin_problem_1d("double-well", 1, 0.5, 10);
   std::printf("double well, kT = 0.5, gamma = 1: exact stationary biases of <q^2> and <q^4> (grid %d x %d)\n", points,
               points);
@@ -90,6 +94,27 @@ int main(int argc, char** argv) {
                   b->q4[1], b->q2[2], b->q4[2]);
     }
     std::fflush(stdout);
+  }
+  if (!csv.empty()) {
+    const std::string tmp = csv + ".tmp";
+    {
+      std::ofstream out(tmp);
+      out << "h,method,forces_per_time,bias_q2,bias_q4\n";
+      out.precision(17);
+      for (const auto& [h, b] : scan)
+        if (b)
+          for (int n = 0; n < 3; ++n)
+            out << h << ",\"" << kNames[n] << "\"," << kForcesPerStep[n] / h << ',' << b->q2[n] << ',' << b->q4[n]
+                << '\n';
+      if (!out) {
+        std::fprintf(stderr, "cannot write %s\n", tmp.c_str());
+        return 1;
+      }
+    }
+    if (std::rename(tmp.c_str(), csv.c_str()) != 0) {
+      std::fprintf(stderr, "cannot rename %s to %s\n", tmp.c_str(), csv.c_str());
+      return 1;
+    }
   }
   // BAOAB's h^2 coefficient: Richardson from 0.05 and 0.025.
   const auto b05 = biases(p, 0.05, points, 1), b025 = biases(p, 0.025, points, 1);
@@ -119,7 +144,7 @@ int main(int argc, char** argv) {
         h = scan[first].first;
         if (first > 0 && scan[first - 1].second) {  // refine between h and the next larger h, which failed by bias
           double lo = h, hi = scan[first - 1].first;
-          for (int it = 0; it < 12; ++it) {
+          for (int it = 0; it < 8; ++it) {
             const double mid = 0.5 * (lo + hi);
             const auto b = biases(p, mid, points);
             (b && within(*b, n, target) ? lo : hi) = mid;
