@@ -125,6 +125,12 @@ int run_stationary_law(const Options& o, const std::vector<long>& extrapolate) {
   opt.h = o.h;
   opt.extrapolate = extrapolate;
   opt.grid.nq = opt.grid.nv = o.grid_points;
+  // The most work the run may take: every member up to max_steps steps of about 5 n^3 multiply-adds, counted as
+  // n^3 / 2 force evaluations of the work limit's unit.
+  const double n = o.grid_points;
+  nystrom::cli::check_work_budget(
+      static_cast<double>(extrapolate.size()) * static_cast<double>(opt.max_steps) * n * n * n / 2,
+      "langevin --stationary-law");
   nystrom::cli::Progress progress("stationary law (members)", static_cast<long>(extrapolate.size()));
   opt.progress = [&progress](std::size_t done, std::size_t) { progress.tick(static_cast<long>(done)); };
   const st::StationaryLawResult r = st::stationary_law(problem, opt);

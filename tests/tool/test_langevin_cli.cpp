@@ -161,4 +161,8 @@ TEST(LangevinCli, StationaryLawRefusalsAreOneLineAndExitTwo) {
     EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << args << ": " << r.err;
     EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
   }
+  // The run's largest possible work (every member to max_steps) is checked against the work limit first.
+  const auto limited = run("langevin --stationary-law", temp_dir(), "env NYSTROM_WORK_LIMIT=1e6");
+  EXPECT_EQ(limited.code, 2) << limited.err;
+  EXPECT_NE(limited.err.find("estimated work"), std::string::npos) << limited.err;
 }
