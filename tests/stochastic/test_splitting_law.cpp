@@ -11,41 +11,16 @@
 
 #include "nystrom/stochastic/potentials.hpp"
 #include "nystrom/stochastic/splitting_law.hpp"
+#include "support/double_well.hpp"
 
 namespace st = nystrom::stochastic;
 
 namespace {
 
-// Chin eq 14 written out here: c_i = prod_{j != i} k_i^2 / (k_i^2 - k_j^2).
-std::vector<double> chin(const std::vector<double>& k) {
-  std::vector<double> c;
-  for (std::size_t i = 0; i < k.size(); ++i) {
-    double ci = 1;
-    for (std::size_t j = 0; j < k.size(); ++j)
-      if (j != i) ci *= k[i] * k[i] / (k[i] * k[i] - k[j] * k[j]);
-    c.push_back(ci);
-  }
-  return c;
-}
-
 std::size_t index_of(const st::StationaryLawResult& r, const std::string& name) {
   for (std::size_t j = 0; j < r.observable_names.size(); ++j)
     if (r.observable_names[j] == name) return j;
   throw std::runtime_error("no observable " + name);
-}
-
-// <q^2> and <q^4> of exp(-(q^2 - 1)^2 / kT) by Simpson's rule on [-4, 4].
-std::pair<double, double> double_well_moments(double kT) {
-  double z = 0, m2 = 0, m4 = 0;
-  const int n = 8000;
-  for (int i = 0; i <= n; ++i) {
-    const double q = -4 + 8.0 * i / n, u = (q * q - 1) * (q * q - 1);
-    const double w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2), rho = w * std::exp(-u / kT);
-    z += rho;
-    m2 += rho * q * q;
-    m4 += rho * q * q * q * q;
-  }
-  return {m2 / z, m4 / z};
 }
 
 std::string refusal(const auto& problem, const st::StationaryLawOptions& o) {
@@ -80,7 +55,7 @@ TEST(SplittingLaw, HarmonicStationaryVariancesAreTheClosedForms) {
   o.method = "OBABO";
   o.extrapolate = {1, 2, 3};
   const auto ob = st::stationary_law(p, o);
-  const auto c = chin({1, 2, 3});
+  const auto c = test_support::chin_coefficients({1, 2, 3});
   double predicted = 0;
   for (std::size_t i = 0; i < 3; ++i) {
     const double hi = h / static_cast<double>(i + 1), xi = hi * hi * w * w / 4;
@@ -100,7 +75,7 @@ TEST(SplittingLaw, HarmonicStationaryVariancesAreTheClosedForms) {
 // term is small, and 4.4 on <q^4>; 1,2,3 6.8 and 6.4).
 TEST(SplittingLaw, DoubleWellWeakOrdersTwoFourAndSix) {
   const double kT = 0.5;
-  const auto [m2, m4] = double_well_moments(kT);
+  const auto [m2, m4] = test_support::double_well_moments(kT);
   const auto p = st::builtin_problem_1d("double-well", 1, kT, 10);
   std::vector<st::StationaryLawResult> runs;
   for (const double h : {0.2, 0.1}) {
@@ -117,7 +92,7 @@ TEST(SplittingLaw, DoubleWellWeakOrdersTwoFourAndSix) {
     for (int n = 1; n <= 3; ++n) {
       std::vector<double> k;
       for (int i = 1; i <= n; ++i) k.push_back(i);
-      const auto c = chin(k);
+      const auto c = test_support::chin_coefficients(k);
       for (int s = 0; s < 2; ++s) {
         double a = 0;
         for (int i = 0; i < n; ++i)

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/cli_runner.hpp"
+#include "support/double_well.hpp"
 
 namespace {
 
@@ -19,25 +20,13 @@ const std::string kCommand =
     "langevin --potential double-well --gamma 1 --kT 0.5 --method BAOAB --h 0.05 --paths 600 --t-end 100 "
     "--extrapolate 1,2,3 --seed 1 --json";
 
-// <q^2>, <q^4> of exp(-(q^2 - 1)^2 / kT) by Simpson's rule on [-4, 4].
-std::pair<double, double> boltzmann_moments(double kT) {
-  double z = 0, m2 = 0, m4 = 0;
-  const int n = 4000;
-  for (int i = 0; i <= n; ++i) {
-    const double q = -4 + 8.0 * i / n, u = (q * q - 1) * (q * q - 1);
-    const double rho = ((i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2)) * std::exp(-u / kT);
-    z += rho, m2 += rho * q * q, m4 += rho * q * q * q * q;
-  }
-  return {m2 / z, m4 / z};
-}
-
 }  // namespace
 
 TEST(LangevinCli, ContractJsonAgreesWithTheBoltzmannDensityForAnyThreadCount) {
   const auto one = run(kCommand + " --threads 1");
   ASSERT_EQ(one.code, 0) << one.err;
   const auto j = nlohmann::json::parse(one.out);
-  const auto [m2, m4] = boltzmann_moments(0.5);
+  const auto [m2, m4] = test_support::double_well_moments(0.5);
   for (const auto& [name, exact] : {std::pair{"q2", m2}, std::pair{"q4", m4}}) {
     const auto& e = j.at("averages").at(name);
     const double value = e.at("value").get<double>(), se = e.at("stderr").get<double>();
@@ -124,7 +113,7 @@ TEST(LangevinCli, StationaryLawIsExactWithoutPaths) {
           "1,2,3 --json");
   ASSERT_EQ(w.code, 0) << w.err;
   const auto d = nlohmann::json::parse(w.out);
-  const auto [m2, m4] = boltzmann_moments(0.5);
+  const auto [m2, m4] = test_support::double_well_moments(0.5);
   EXPECT_NEAR(d.at("boltzmann").at("q2").get<double>(), m2, 1e-12);
   EXPECT_NEAR(d.at("boltzmann").at("q4").get<double>(), m4, 1e-12);
   EXPECT_LT(std::abs(d.at("stationary").at("q2").get<double>() - m2), 1e-8);

@@ -168,6 +168,21 @@ struct LangevinResult {
   std::vector<ObservableResult> observables;
 };
 
+/// Checks an extrapolation sequence for a splitting: distinct positive members, at most max_members, and more
+/// than one only for a symmetric splitting (throws nystrom::invalid_input with one line).
+inline void check_extrapolation(const LangevinSplitting& splitting, const std::vector<long>& k) {
+  try {
+    validate_mpe_sequence(k);
+  } catch (const std::invalid_argument& e) {
+    throw invalid_input(e.what());
+  }
+  if (k.size() > max_members)
+    throw invalid_input("an extrapolation sequence has at most " + std::to_string(max_members) + " members here");
+  if (k.size() > 1 && !splitting.symmetric)
+    throw invalid_input("extrapolation needs a symmetric splitting (one that reads the same backwards, e.g. BAOAB): '" +
+                        splitting.name + "' has an error in odd powers of h too");
+}
+
 namespace detail {
 
 struct Plan {
@@ -211,16 +226,7 @@ Plan make_plan(const P& problem, const LangevinOptions& o) {
     throw invalid_input("the number of paths must be between 1 and " + std::to_string(max_paths) + ", got " +
                         std::to_string(o.paths));
   if (o.threads < 1 || o.threads > 1024) throw invalid_input("threads must be between 1 and 1024");
-  try {
-    validate_mpe_sequence(o.extrapolate);
-  } catch (const std::invalid_argument& e) {
-    throw invalid_input(e.what());
-  }
-  if (o.extrapolate.size() > max_members)
-    throw invalid_input("an extrapolation sequence has at most " + std::to_string(max_members) + " members here");
-  if (o.extrapolate.size() > 1 && !p.splitting.symmetric)
-    throw invalid_input("extrapolation needs a symmetric splitting (one that reads the same backwards, e.g. BAOAB): '" +
-                        p.splitting.name + "' has an error in odd powers of h too");
+  check_extrapolation(p.splitting, o.extrapolate);
   p.k = o.extrapolate;
   for (long k : p.k) {
     p.lcm = std::lcm(p.lcm, k);

@@ -246,16 +246,7 @@ StationaryLawResult stationary_law(const LangevinProblem<Acceleration, Observe>&
   if (problem.observable_names.empty()) throw invalid_input("a stationary law needs at least one observable");
   if (!(o.tol > 0) || !std::isfinite(o.tol)) throw invalid_input("the tolerance must be positive and finite");
   if (o.max_steps < 1) throw invalid_input("max_steps must be positive");
-  try {
-    validate_mpe_sequence(o.extrapolate);
-  } catch (const std::invalid_argument& e) {
-    throw invalid_input(e.what());
-  }
-  if (o.extrapolate.size() > max_members)
-    throw invalid_input("an extrapolation sequence has at most " + std::to_string(max_members) + " members here");
-  if (o.extrapolate.size() > 1 && !sp.symmetric)
-    throw invalid_input("extrapolation needs a symmetric splitting (one that reads the same backwards, e.g. BAOAB): '" +
-                        sp.name + "' has an error in odd powers of h too");
+  check_extrapolation(sp, o.extrapolate);
 
   PhaseGrid g = o.grid;
   if (g.nq == 0) g.nq = 65;
