@@ -54,7 +54,13 @@ TEST(SplittingLaw, HarmonicStationaryVariancesAreTheClosedForms) {
   EXPECT_LT(b.edge, 1e-12);
   o.method = "OBABO";
   o.extrapolate = {1, 2, 3};
+  std::vector<std::size_t> reported;  // progress: once per member, with the number done
+  o.progress = [&](std::size_t done, std::size_t total) {
+    reported.push_back(done);
+    EXPECT_EQ(total, 3u);
+  };
   const auto ob = st::stationary_law(p, o);
+  EXPECT_EQ(reported, (std::vector<std::size_t>{1, 2, 3}));
   const auto c = test_support::chin_coefficients({1, 2, 3});
   double predicted = 0;
   for (std::size_t i = 0; i < 3; ++i) {

@@ -96,16 +96,20 @@ inline std::string num(double x) {
 
 inline constexpr double pi = std::numbers::pi;
 
-// The Dirichlet kernel of n (odd) points with period p, at x.
+// The band-limited periodic kernel of n (odd) points with period p, at x: (1/n) sum_{|k| <= (n-1)/2} g_k
+// cos(2 pi k x / p), with g_0 = 1 and g_k = g[k - 1] (g empty: all 1, the Dirichlet kernel).
+inline double cosine_sum(int n, double p, double x, const std::vector<double>& g) {
+  double sum = 1;
+  for (int k = 1; k <= (n - 1) / 2; ++k)
+    sum += 2 * (g.empty() ? 1.0 : g[static_cast<std::size_t>(k) - 1]) * std::cos(2 * pi * k / p * x);
+  return sum / n;
+}
+
+// The Dirichlet kernel of n (odd) points with period p, at x (its closed form away from the multiples of p).
 inline double dirichlet(int n, double p, double x) {
   x -= p * std::nearbyint(x / p);
-  const double s = std::sin(pi * x / p);
-  if (std::abs(x) < 1e-9 * p) {
-    double sum = 1;
-    for (int k = 1; k <= (n - 1) / 2; ++k) sum += 2 * std::cos(2 * pi * k * x / p);
-    return sum / n;
-  }
-  return std::sin(n * pi * x / p) / (n * s);
+  if (std::abs(x) < 1e-9 * p) return cosine_sum(n, p, x, {});
+  return std::sin(n * pi * x / p) / (n * std::sin(pi * x / p));
 }
 
 // A circulant shift by `shift` on n points of spacing d: y_i = sum_j w[n - 1 - i + j] x_j.
@@ -163,6 +167,14 @@ inline double outer_spectrum(int rows, int n, const std::vector<double>& a) {
   return total > 0 ? std::sqrt(outer / total) : 0;
 }
 
+// The acceleration a(q) of a one-dimensional problem at q.
+template <class Acceleration>
+double acceleration_at(const Acceleration& acc, double at) {
+  std::array<double, 1> q{at}, a{};
+  acc(std::span<const double>(q), std::span<double>(a));
+  return a[0];
+}
+
 // The potential energy m * U(q) / m on the grid points, up to a constant, by integrating -m a(q) with 8-point
 // Gauss-Legendre quadrature over each cell from the first point.
 template <class Acceleration>
@@ -172,12 +184,7 @@ std::vector<double> potential_on(const Acceleration& acc, double mass, double q0
   static constexpr std::array<double, 4> w = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
                                               0.1012285362903763};
   std::vector<double> u(static_cast<std::size_t>(n), 0.0);
-  std::array<double, 1> q{}, a{};
-  const auto force = [&](double at) {
-    q[0] = at;
-    acc(std::span<const double>(q), std::span<double>(a));
-    return a[0];
-  };
+  const auto force = [&](double at) { return acceleration_at(acc, at); };
   for (int j = 1; j < n; ++j) {
     const double mid = q0 + (j - 0.5) * dq, half = 0.5 * dq;
     double integral = 0;
@@ -193,15 +200,8 @@ template <class Acceleration>
 std::pair<double, double> confining_range(const Acceleration& acc, double mass, double kT, double q0) {
   const double step = 1.0 / 64, limit = 40;
   const int most = 64000;
-  std::array<double, 1> q{}, a{};
-  const auto force = [&](double at) {
-    q[0] = at;
-    acc(std::span<const double>(q), std::span<double>(a));
-    return a[0];
-  };
+  const auto force = [&](double at) { return acceleration_at(acc, at); };
   double ends[2];
-  double umin = 0;
-  std::vector<double> up, down;  // beta U along each direction, from q0
   for (int dir = 0; dir < 2; ++dir) {
     const double sgn = dir == 0 ? 1.0 : -1.0;
     double u = 0, lowest = 0;
@@ -218,9 +218,7 @@ std::pair<double, double> confining_range(const Acceleration& acc, double mass, 
       throw invalid_input("the potential does not confine the Boltzmann density within 1000 of q0 " +
                           std::string("on one side: give the grid's q range"));
     ends[dir] = q0 + sgn * k * step;
-    umin = std::min(umin, lowest);
   }
-  (void)umin;
   return {ends[1], ends[0]};
 }
 
@@ -273,14 +271,11 @@ StationaryLawResult stationary_law(const LangevinProblem<Acceleration, Observe>&
 
   // Forces, observables and the Boltzmann density on the grid (rows: v, columns: q).
   std::vector<double> acc(static_cast<std::size_t>(nq));
-  {
-    std::array<double, 1> q{}, a{};
-    for (int j = 0; j < nq; ++j) {
-      q[0] = qs[static_cast<std::size_t>(j)];
-      problem.acceleration(std::span<const double>(q), std::span<double>(a));
-      if (!std::isfinite(a[0])) throw invalid_input("the acceleration is not finite on the phase-space grid");
-      acc[static_cast<std::size_t>(j)] = a[0];
-    }
+  for (int j = 0; j < nq; ++j) {
+    acc[static_cast<std::size_t>(j)] =
+        law_detail::acceleration_at(problem.acceleration, qs[static_cast<std::size_t>(j)]);
+    if (!std::isfinite(acc[static_cast<std::size_t>(j)]))
+      throw invalid_input("the acceleration is not finite on the phase-space grid");
   }
   const std::size_t nobs = problem.observable_names.size();
   std::vector<double> phi(nobs * cells);
@@ -342,62 +337,62 @@ StationaryLawResult stationary_law(const LangevinProblem<Acceleration, Observe>&
   std::vector<double> rho(cells), rhot(cells), tmp(std::max(nq, nv));
   for (std::size_t mi = 0; mi < o.extrapolate.size(); ++mi) {
     const double tau = o.h / static_cast<double>(o.extrapolate[mi]);
-    // The kernels of this step's flows, per distinct sub-step.
-    struct Kernels {
-      double fraction;
-      std::vector<double> w;  // A: nv shifts of 2 nq - 1; B: nq shifts of 2 nv - 1; O: nv x nv
-    };
-    std::vector<Kernels> drift, kick, noise;
-    const auto find = [](std::vector<Kernels>& ks, double f) -> Kernels* {
-      for (auto& k : ks)
-        if (k.fraction == f) return &k;
-      return nullptr;
-    };
-    for (const Stage& st : sp.stages) {
+    // The kernel of each stage, one per distinct flow and sub-step (stages that repeat one share it): A: nv
+    // shifts of 2 nq - 1 weights; B: nq shifts of 2 nv - 1; O: an nv x nv matrix.
+    std::vector<std::vector<double>> kernels;
+    std::vector<std::size_t> kernel_of(sp.stages.size());
+    for (std::size_t i = 0; i < sp.stages.size(); ++i) {
+      const Stage& st = sp.stages[i];
+      std::size_t same = 0;
+      while (same < i && (sp.stages[same].flow != st.flow || sp.stages[same].fraction != st.fraction)) ++same;
+      if (same < i) {
+        kernel_of[i] = kernel_of[same];
+        continue;
+      }
+      kernel_of[i] = kernels.size();
       const double t = tau * st.fraction;
-      if (st.flow == Flow::drift && !find(drift, st.fraction)) {
-        Kernels k{st.fraction, std::vector<double>(static_cast<std::size_t>(nv) * (2 * nq - 1))};
+      std::vector<double> w;
+      if (st.flow == Flow::drift) {
+        w.resize(static_cast<std::size_t>(nv) * (2 * nq - 1));
         for (int l = 0; l < nv; ++l)
           law_detail::shift_weights(nq, dq, t * vs[static_cast<std::size_t>(l)],
-                                    k.w.data() + static_cast<std::size_t>(l) * (2 * nq - 1));
-        drift.push_back(std::move(k));
-      } else if (st.flow == Flow::kick && !find(kick, st.fraction)) {
-        Kernels k{st.fraction, std::vector<double>(static_cast<std::size_t>(nq) * (2 * nv - 1))};
+                                    w.data() + static_cast<std::size_t>(l) * (2 * nq - 1));
+      } else if (st.flow == Flow::kick) {
+        w.resize(static_cast<std::size_t>(nq) * (2 * nv - 1));
         for (int j = 0; j < nq; ++j)
           law_detail::shift_weights(nv, dv, t * acc[static_cast<std::size_t>(j)],
-                                    k.w.data() + static_cast<std::size_t>(j) * (2 * nv - 1));
-        kick.push_back(std::move(k));
-      } else if (st.flow == Flow::ou && !find(noise, st.fraction)) {
+                                    w.data() + static_cast<std::size_t>(j) * (2 * nv - 1));
+      } else {
         const double c = std::exp(-problem.gamma * t), s2 = problem.kT / problem.mass * (1 - c * c);
-        Kernels k{st.fraction, std::vector<double>(static_cast<std::size_t>(nv) * nv)};
         const double period = nv * dv;
+        std::vector<double> g(static_cast<std::size_t>((nv - 1) / 2));
+        for (std::size_t kk = 0; kk < g.size(); ++kk) {
+          const double kappa = 2 * pi * static_cast<double>(kk + 1) / period;
+          g[kk] = std::exp(-0.5 * s2 * kappa * kappa);
+        }
+        w.resize(static_cast<std::size_t>(nv) * nv);
         for (int l = 0; l < nv; ++l)
-          for (int m = 0; m < nv; ++m) {
-            const double x = vs[static_cast<std::size_t>(l)] - c * vs[static_cast<std::size_t>(m)];
-            double sum = 1;
-            for (int kk = 1; kk <= (nv - 1) / 2; ++kk) {
-              const double kappa = 2 * pi * kk / period;
-              sum += 2 * std::exp(-0.5 * s2 * kappa * kappa) * std::cos(kappa * x);
-            }
-            k.w[static_cast<std::size_t>(l) * nv + m] = sum / nv;
-          }
-        noise.push_back(std::move(k));
+          for (int m = 0; m < nv; ++m)
+            w[static_cast<std::size_t>(l) * nv + m] = law_detail::cosine_sum(
+                nv, period, vs[static_cast<std::size_t>(l)] - c * vs[static_cast<std::size_t>(m)], g);
       }
+      kernels.push_back(std::move(w));
     }
     // rho: rows v (nv x nq); rhot: rows q (nq x nv). `rows_q` says which one holds the density.
     rho = boltz;
     bool rows_q = false;
     const auto step = [&] {
-      for (const Stage& st : sp.stages) {
+      for (std::size_t i = 0; i < sp.stages.size(); ++i) {
+        const Stage& st = sp.stages[i];
+        const std::vector<double>& w = kernels[kernel_of[i]];
         if (st.flow == Flow::drift) {
           if (rows_q) {
             law_detail::transpose(nq, nv, rhot, rho);
             rows_q = false;
           }
-          const Kernels& k = *find(drift, st.fraction);
           for (int l = 0; l < nv; ++l) {
             double* row = rho.data() + static_cast<std::size_t>(l) * nq;
-            law_detail::apply_circulant(nq, k.w.data() + static_cast<std::size_t>(l) * (2 * nq - 1), row, tmp.data());
+            law_detail::apply_circulant(nq, w.data() + static_cast<std::size_t>(l) * (2 * nq - 1), row, tmp.data());
             std::copy_n(tmp.data(), nq, row);
           }
         } else {
@@ -405,20 +400,13 @@ StationaryLawResult stationary_law(const LangevinProblem<Acceleration, Observe>&
             law_detail::transpose(nv, nq, rho, rhot);
             rows_q = true;
           }
-          if (st.flow == Flow::kick) {
-            const Kernels& k = *find(kick, st.fraction);
-            for (int j = 0; j < nq; ++j) {
-              double* col = rhot.data() + static_cast<std::size_t>(j) * nv;
-              law_detail::apply_circulant(nv, k.w.data() + static_cast<std::size_t>(j) * (2 * nv - 1), col, tmp.data());
-              std::copy_n(tmp.data(), nv, col);
-            }
-          } else {
-            const Kernels& k = *find(noise, st.fraction);
-            for (int j = 0; j < nq; ++j) {
-              double* col = rhot.data() + static_cast<std::size_t>(j) * nv;
-              law_detail::apply_dense(nv, k.w.data(), col, tmp.data());
-              std::copy_n(tmp.data(), nv, col);
-            }
+          for (int j = 0; j < nq; ++j) {
+            double* col = rhot.data() + static_cast<std::size_t>(j) * nv;
+            if (st.flow == Flow::kick)
+              law_detail::apply_circulant(nv, w.data() + static_cast<std::size_t>(j) * (2 * nv - 1), col, tmp.data());
+            else
+              law_detail::apply_dense(nv, w.data(), col, tmp.data());
+            std::copy_n(tmp.data(), nv, col);
           }
         }
       }
@@ -488,9 +476,10 @@ StationaryLawResult stationary_law(const LangevinProblem<Acceleration, Observe>&
     law_detail::transpose(nv, nq, rho, rhot);
     r.resolution =
         std::max({r.resolution, law_detail::outer_spectrum(nv, nq, rho), law_detail::outer_spectrum(nq, nv, rhot)});
+    if (r.resolution > max_law_defect || r.edge > max_law_defect) refuse(r.edge, r.resolution);
+    if (o.progress) o.progress(mi + 1, o.extrapolate.size());
   }
   r.grid = g;
-  if (r.resolution > max_law_defect || r.edge > max_law_defect) refuse(r.edge, r.resolution);
   return r;
 }
 
