@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "nystrom/methods/mpe_coefficients.hpp"
 #include "nystrom/stochastic/potentials.hpp"
 #include "nystrom/stochastic/splitting_law.hpp"
 
@@ -35,9 +36,9 @@ struct Biases {
   double q2[3], q4[3];  // BAOAB, 1,2, 1,2,3
 };
 
-const std::vector<std::vector<double>> kCoefficients = {{1}, {-1.0 / 3, 4.0 / 3}, {1.0 / 24, -16.0 / 15, 81.0 / 40}};
 const char* const kNames[3] = {"BAOAB", "1,2", "1,2,3"};
-const double kForcesPerStep[3] = {1, 3, 6};
+// BAOAB reuses its last force: the combination of 1..n costs 1 + 2 + ... + n forces per step h.
+const double kForcesPerStep[3] = {1, 1 + 2, 1 + 2 + 3};
 
 // The biases from one law with the members h, h/2, .., h/members (the combinations beyond `members` are not set).
 std::optional<Biases> biases(const st::Problem1D& p, double h, int points, int members = 3) {
@@ -54,10 +55,14 @@ std::optional<Biases> biases(const st::Problem1D& p, double h, int points, int m
   }
   Biases b{};
   for (int n = 0; n < members; ++n) {
+    // The combination of the members 1..n + 1 with the multi-product coefficients of that sequence.
+    std::vector<long> seq;
+    for (long k = 1; k <= n + 1; ++k) seq.push_back(k);
+    const nystrom::MpeCoefficients c = nystrom::mpe_coefficients(seq);
     double a2 = 0, a4 = 0;
     for (int i = 0; i <= n; ++i) {
-      a2 += kCoefficients[n][i] * r.members[i][1];
-      a4 += kCoefficients[n][i] * r.members[i][2];
+      a2 += c.c[static_cast<std::size_t>(i)].get_d() * r.members[i][1];
+      a4 += c.c[static_cast<std::size_t>(i)].get_d() * r.members[i][2];
     }
     b.q2[n] = a2 - r.boltzmann[1];
     b.q4[n] = a4 - r.boltzmann[2];
