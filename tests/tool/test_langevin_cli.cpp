@@ -20,6 +20,15 @@ const std::string kCommand =
     "langevin --potential double-well --gamma 1 --kT 0.5 --method BAOAB --h 0.05 --paths 600 --t-end 100 "
     "--extrapolate 1,2,3 --seed 1 --json";
 
+// `nystrom ARGS` exits 2 with one line `nystrom: error: ...` on stderr and nothing on stdout.
+void expect_one_line_refusal(const std::string& args) {
+  const auto r = run(args);
+  EXPECT_EQ(r.code, 2) << args << "\n" << r.out << r.err;
+  EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << args << ": " << r.err;
+  EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+}
+
 }  // namespace
 
 TEST(LangevinCli, ContractJsonAgreesWithTheBoltzmannDensityForAnyThreadCount) {
@@ -84,11 +93,7 @@ TEST(LangevinCli, BadInputIsOneLineAndExitTwo) {
            "langevin --threads -1",
            "langevin --potential harmonic --omega 10 --gamma 0.01 --h 0.5 --t-end 100 --paths 10",
        }) {
-    const auto r = run(args);
-    EXPECT_EQ(r.code, 2) << args << "\n" << r.out << r.err;
-    EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << args << ": " << r.err;
-    EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+    expect_one_line_refusal(args);
   }
 }
 
@@ -144,11 +149,7 @@ TEST(LangevinCli, StationaryLawRefusalsAreOneLineAndExitTwo) {
            "langevin --stationary-law --method BAO --extrapolate 1,2",
            "langevin --stationary-law --potential double-well --kT 0.5 --h 0.4",
        }) {
-    const auto r = run(args);
-    EXPECT_EQ(r.code, 2) << args << "\n" << r.out << r.err;
-    EXPECT_EQ(r.err.rfind("nystrom: error: ", 0), 0u) << args << ": " << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << args << ": " << r.err;
-    EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+    expect_one_line_refusal(args);
   }
   // The run's largest possible work (every member to max_steps) is checked against the work limit first.
   const auto limited = run("langevin --stationary-law", temp_dir(), "env NYSTROM_WORK_LIMIT=1e6");
