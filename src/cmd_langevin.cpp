@@ -51,6 +51,13 @@ int thread_count(int t) {
   return n == 0 ? 1 : static_cast<int>(std::min(n, 64u));
 }
 
+// "1,2,3"
+std::string sequence_text(const std::vector<long>& k) {
+  std::string s;
+  for (long x : k) s += (s.empty() ? "" : ",") + std::to_string(x);
+  return s;
+}
+
 nlohmann::json estimate(const st::Estimate& e) { return {{"value", e.value}, {"stderr", e.stderr_}}; }
 
 nlohmann::json to_json(const Options& o, const st::LangevinResult& r) {
@@ -117,8 +124,7 @@ nlohmann::json law_to_json(const Options& o, const st::StationaryLawResult& r) {
 }
 
 int run_stationary_law(const Options& o, const std::vector<long>& extrapolate) {
-  if (o.grid_points < 9 || o.grid_points > 257 || o.grid_points % 2 == 0)
-    throw UsageError("--grid-points must be odd, 9 to 257, got " + std::to_string(o.grid_points));
+  st::check_front_end_grid_points(o.grid_points, "--grid-points");
   const auto problem = st::builtin_problem_1d(o.potential, o.gamma, o.kT, 1.0, o.q0, o.v0, o.omega);
   st::StationaryLawOptions opt;
   opt.method = o.method;
@@ -138,8 +144,7 @@ int run_stationary_law(const Options& o, const std::vector<long>& extrapolate) {
     std::cout << law_to_json(o, r).dump(2) << "\n";
     return 0;
   }
-  std::string seq;
-  for (long k : r.extrapolate) seq += (seq.empty() ? "" : ",") + std::to_string(k);
+  const std::string seq = sequence_text(r.extrapolate);
   fmt::print("problem        {} (gamma {}, kT {})\n", o.potential, o.gamma, o.kT);
   fmt::print("method         {}, h {}, extrapolated with {} (weak order {})\n", r.method, r.h, seq, r.order);
   fmt::print("stationary law on a {} x {} grid, q in [{:.4g}, {:.4g}), |v| < {:.4g}; steps to the fixed point:",
@@ -233,8 +238,7 @@ nystrom::cli::Registrar reg(
           std::cout << to_json(*o, r).dump(2) << "\n";
           return 0;
         }
-        std::string seq;
-        for (long k : r.extrapolate) seq += (seq.empty() ? "" : ",") + std::to_string(k);
+        const std::string seq = sequence_text(r.extrapolate);
         fmt::print("problem        {} (gamma {}, kT {}), q0 {}, v0 {}\n", o->potential, o->gamma, o->kT, o->q0, o->v0);
         fmt::print("method         {}, h {}, {} steps to t = {}, extrapolated with {} (weak order {})\n", r.method, r.h,
                    r.steps, r.t_end, seq, r.order);

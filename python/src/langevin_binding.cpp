@@ -176,8 +176,7 @@ py::dict langevin_finish(const Request& q, const py::list& parts) {
 // --stationary-law --json`).
 py::dict stationary_law(const std::string& potential, double omega, double gamma, double kT, double q0,
                         const std::string& method, double h, const std::vector<long>& extrapolate, int grid_points) {
-  if (grid_points < 9 || grid_points > 257 || grid_points % 2 == 0)
-    throw invalid_input("grid_points must be odd, 9 to 257, got " + std::to_string(grid_points));
+  st::check_front_end_grid_points(grid_points, "grid_points");
   const auto problem = st::builtin_problem_1d(potential, gamma, kT, 1.0, q0, 0.0, omega);
   st::StationaryLawOptions o;
   o.method = method;

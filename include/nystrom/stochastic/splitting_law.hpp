@@ -80,6 +80,17 @@ struct StationaryLawResult {
 /// its spectrum in the outer quarter of the wave numbers, is refused.
 inline constexpr double max_law_defect = 1e-5;
 
+/// The most grid points per axis the tool and the Python module take (a step costs about 5 n^3 multiply-adds).
+inline constexpr int max_front_end_grid_points = 257;
+
+/// The tool's and the Python module's check of their grid points (named `name` in the message): odd, 9 to
+/// max_front_end_grid_points; throws nystrom::invalid_input with one line otherwise.
+inline void check_front_end_grid_points(int n, const std::string& name) {
+  if (n < 9 || n > max_front_end_grid_points || n % 2 == 0)
+    throw invalid_input(name + " must be odd, 9 to " + std::to_string(max_front_end_grid_points) + ", got " +
+                        std::to_string(n));
+}
+
 namespace law_detail {
 
 inline std::string sci(double x) {
