@@ -12,6 +12,8 @@
 #include <iostream>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "nystrom/engines/adaptive_mpe.hpp"
@@ -221,6 +223,47 @@ TEST(AdaptiveMpe, SchedulesAreBitwiseIdentical) {
     }
 }
 
+// std::array states of long double run the unrolled controller loop (as float and double do) in lockstep, and the
+// run-time one in sequence and on std::vector: bitwise the same trajectory and force count, for fixed and controlled
+// order, drift- and kick-first bases, with and without compensated summation.
+namespace {
+template <class V>
+std::pair<State<V>, long> long_double_run(const char* spec, Compensation comp, MpeSchedule sched) {
+  long calls = 0;
+  EngineOptions eo;
+  eo.compensated = comp;
+  eo.mpe_schedule = sched;
+  auto ai = make_adaptive_mpe_integrator<V>(resolve_method(spec), CountingKepler{&calls}, with_tol(1e-12), eo);
+  const auto s0 = KeplerProblem<long double>(0.9L).initial_state();
+  State<V> s{{s0.q[0], s0.q[1]}, {s0.v[0], s0.v[1]}};
+  const AdaptiveStats st = ai.integrate_to(s, 0.0L, 7.0L);
+  EXPECT_EQ(st.force_evals, calls);
+  return {s, st.force_evals};
+}
+}  // namespace
+
+TEST(AdaptiveMpe, LongDoubleArraysAgreeWithTheRunTimePathBitwise) {
+  using VL = std::array<long double, 2>;
+  using VLD = std::vector<long double>;
+  for (const char* spec : {"M12-adaptive", "mpe-vv-adaptive:3,1,5,2", "MPE-adaptive"})
+    for (Compensation comp : {Compensation::on, Compensation::off}) {
+      SCOPED_TRACE(std::string(spec) + (comp == Compensation::on ? " compensated" : " plain"));
+      const auto [a, fa] = long_double_run<VL>(spec, comp, MpeSchedule::lockstep);
+      const auto [b, fb] = long_double_run<VL>(spec, comp, MpeSchedule::sequential);
+      const auto [c, fc] = long_double_run<VLD>(spec, comp, MpeSchedule::lockstep);
+      EXPECT_GT(fa, 1000);
+      EXPECT_EQ(fa, fb);
+      EXPECT_EQ(fa, fc);
+      for (int i = 0; i < 2; ++i) {
+        EXPECT_TRUE(a.q[i] == b.q[i] && a.v[i] == b.v[i]) << i;
+        EXPECT_TRUE(a.q[i] == c.q[i] && a.v[i] == c.v[i]) << i;
+      }
+      // The run is long double's: it ends near the exact orbit, far below double's rounding.
+      const auto ex = KeplerProblem<long double>(0.9L).exact(7.0L);
+      EXPECT_LT(std::hypot(a.q[0] - ex.q[0], a.q[1] - ex.q[1]), 1e-9L);
+    }
+}
+
 // A base that starts with a kick (velocity Verlet) shares the force at q_0 among the products: one
 // more force per accepted step (kept across a rejected one).
 TEST(AdaptiveMpe, VelocityVerletBaseCountsTheSharedForce) {
@@ -413,7 +456,7 @@ TEST(AdaptiveMpeOrderControl, PinnedOrderIsTheFixedOrderEngine) {
   }
 }
 
-// The unrolled path (std::array of double) and the run-time one (std::vector; long double arrays) take the
+// The unrolled path (std::array of double) and the run-time one (std::vector) take the
 // same steps: bitwise the same trajectory, orders and force counts.
 TEST(AdaptiveMpeOrderControl, StateTypesAgree) {
   const MethodDef def = resolve_method("MPE-adaptive");

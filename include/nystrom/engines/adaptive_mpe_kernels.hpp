@@ -5,8 +5,8 @@
 //
 // Cost per step: sum k_i force evaluations (+1 for a base that starts with a kick: the force at q_0,
 // shared by all products and kept across a rejected step). The products of a step run in lockstep so
-// that the processor overlaps their independent force chains; for std::array states of double or
-// float the whole controller loop is compiled per product count (2..8), and for the three-step
+// that the processor overlaps their independent force chains; for std::array states of float, double
+// or long double the whole controller loop is compiled per product count (2..8), and for the three-step
 // (Verlet) bases of the catalog a step is trial_verlet: the products' increments, forces and
 // coefficients in local arrays, the product of largest k issued first in every sub-step (it is the
 // critical chain). An adaptive M12 step on Kepler e = 0.9 (21 forces, a chain of 6) costs 277 ns as a
@@ -44,9 +44,13 @@ class MpeKernels {
   using real_type = scalar_type;
 
  protected:
-  // The unrolled loops are compiled for std::array states of float and double only (as in MpeStepper).
+  // The unrolled loops are compiled for std::array states of float, double and long double (on the x87 stack the
+  // run-time loop passes every long double operand through memory, the unrolled one keeps a step in locals).
+  // Other scalars (complex, float128, double-double, quad-double, MPFR) and std::vector states run the run-time
+  // product count, bitwise the same.
   static constexpr bool fixed_lockstep =
-      is_std_array<V>::value && (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>);
+      is_std_array<V>::value && (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float> ||
+                                 std::is_same_v<scalar_type, long double>);
 
   MpeKernels(std::vector<long> k, std::vector<scalar_type> c, std::vector<scalar_type> d,
              SplittingScheme<scalar_type> base, Force force)
