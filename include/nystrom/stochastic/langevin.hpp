@@ -437,7 +437,7 @@ LangevinResult finish_langevin(const P& problem, const LangevinOptions& options,
   r.paths = stats.paths;
   r.extrapolate = plan.k;
   r.coefficients = plan.c;
-  r.order = 2 * static_cast<int>(plan.k.size());
+  r.order = weak_order(plan.splitting, plan.k.size());
   r.force_evaluations = stats.force_evaluations;
   const std::size_t nk = plan.k.size();
   if (stats.observables != problem.observable_names.size() || stats.members != nk + 1)

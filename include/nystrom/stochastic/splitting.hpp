@@ -10,6 +10,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,6 +32,12 @@ struct LangevinSplitting {
   int ou_stages = 0;       // O letters per step: each takes h / ou_stages
   bool symmetric = false;  // the string reads the same backwards: the weak error is even in h
 };
+
+/// The weak order of the multi-product combination of `members` runs of the splitting: 2 per member for a symmetric
+/// splitting (its weak error is even in h), 1 for any other (which check_extrapolation admits with one member only).
+inline int weak_order(const LangevinSplitting& s, std::size_t members) {
+  return s.symmetric ? 2 * static_cast<int>(members) : 1;
+}
 
 /// Most letters in a splitting string.
 inline constexpr std::size_t max_splitting_letters = 64;

@@ -336,7 +336,7 @@ StationaryLawResult stationary_law(const LangevinProblem<Acceleration, Observe>&
   r.method = sp.name;
   r.h = o.h;
   r.extrapolate = o.extrapolate;
-  r.order = sp.symmetric ? 2 * static_cast<int>(o.extrapolate.size()) : 1;
+  r.order = weak_order(sp, o.extrapolate.size());
   {
     const MpeCoefficients m = mpe_coefficients(o.extrapolate);
     for (const auto& ci : m.c) r.coefficients.push_back(ci.get_d());
