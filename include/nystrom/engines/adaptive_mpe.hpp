@@ -43,6 +43,7 @@
 #include <variant>
 #include <vector>
 
+#include "nystrom/core/eft.hpp"
 #include "nystrom/core/state.hpp"
 #include "nystrom/engines/adaptive_mpe_coefficients.hpp"
 #include "nystrom/engines/adaptive_mpe_kernels.hpp"
@@ -135,6 +136,19 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   int method_order() const { return method_order_; }
   bool lockstep() const { return lockstep_; }
   bool compensated() const { return compensated_; }
+  /// Whether the products carry their own rounding (precise products, engines/adaptive_mpe_kernels.hpp): a
+  /// compensated run of a built-in floating type on a symmetric base whose controlled tolerance (tol, or atol when
+  /// tol is 0, through the method's calibration) is at most kPreciseProducts eps, where the increments' rounding,
+  /// not truncation, sets the error.
+  bool precise_products() const {
+    if (!Kernels::can_be_precise || !compensated_ || !merged_) return false;
+    const double tol = opt_.rtol > 0 ? opt_.rtol : opt_.atol;
+    const double tc = adaptive_detail::controlled_tolerance(tol, opt_.tolerance_exponent, opt_.tolerance_anchor);
+    return tc <= kPreciseProducts * as_double(epsilon_of<real_type>());
+  }
+  /// The largest controlled tolerance, in units of eps, at which the products are precise (1e4: 2.2e-12 in double,
+  /// user tolerance 1e-11 for M12-adaptive).
+  static constexpr double kPreciseProducts = 1e4;
   const std::vector<long>& sequence() const { return k_; }
   const AdaptiveStats& total() const { return total_; }
   /// Order control: the largest number of products per step (0: one order per run).
@@ -169,10 +183,11 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
       base_.force()(s.q, a0_);
       ++extra_evals_;
     }
+    State<V> low = s;
     if (compensated_)
-      this->template trial<true>(k_.size(), s, a0_, xs_, as_, cqs_, cvs_, inc, err);
+      this->template trial<true, false>(k_.size(), s, a0_, xs_, as_, cqs_, cvs_, inc, err, low);
     else
-      this->template trial<false>(k_.size(), s, a0_, xs_, as_, cqs_, cvs_, inc, err);
+      this->template trial<false, false>(k_.size(), s, a0_, xs_, as_, cqs_, cvs_, inc, err, low);
   }
 
   template <class Observer = adaptive_detail::NoObserver>
@@ -206,6 +221,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   using Kernels::as_;
   using Kernels::base_;
   using Kernels::c_;
+  using Kernels::can_be_precise;
   using Kernels::cqs_;
   using Kernels::cvs_;
   using Kernels::d_;
@@ -223,6 +239,12 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   using Kernels::resize_buffers;
   using Kernels::scale;
   using Kernels::xs_;
+
+  // (x, cx) += (d, dl): the double-word increment of precise products added to the state and its carry (an exact
+  // two-sum, eft::add_double_word); the built-in floating types only (other types never run precise products).
+  static void add_increment(scalar_type& x, scalar_type& cx, const scalar_type& d, const scalar_type& dl) {
+    if constexpr (can_be_precise) eft::add_double_word(x, cx, d, dl);
+  }
 
   template <bool Comp, class Observer>
   AdaptiveStats dispatch(State<V>& s, real_type t0, real_type t1, Observer& obs) {
@@ -298,7 +320,8 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
 
     constexpr bool local = K > 0;
     std::conditional_t<local, State<V>, State<V>&> s = s_io;
-    State<V> inc = s_io, err = s_io;
+    State<V> inc = s_io, err = s_io, low = s_io;  // low: the low part of inc (precise products)
+    const bool precise = Comp && precise_products();
     if (!local) resize_buffers(s_io);
     if (Comp) comp_.begin(s_io);
     std::conditional_t<local, V, V&> ccq = comp_.cq, ccv = comp_.cv;
@@ -334,20 +357,30 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
         ++a0_evals;
         a0_valid = true;
       }
-      if constexpr (local) {
-        if (verlet)
-          own_evals_ += this->template trial_verlet<K>(s, a0, h, inc, err);
-        else
-          this->template trial<Comp>(std::integral_constant<std::size_t, K>{}, s, a0, lx, la, lcq, lcv, inc, err);
-      } else
-        this->template trial<Comp>(k_.size(), s, a0, xs_, as_, cqs_, cvs_, inc, err);
+      Kernels::template with_precision<Comp>(precise, [&](auto pr) NYSTROM_ALWAYS_INLINE {
+        constexpr bool P = decltype(pr)::value;
+        if constexpr (local) {
+          if (verlet)
+            own_evals_ += this->template trial_verlet<K, P>(s, a0, h, inc, err, low);
+          else
+            this->template trial<Comp, P>(std::integral_constant<std::size_t, K>{}, s, a0, lx, la, lcq, lcv, inc, err,
+                                          low);
+        } else {
+          this->template trial<Comp, P>(k_.size(), s, a0, xs_, as_, cqs_, cvs_, inc, err, low);
+        }
+      });
       const double e2 = adaptive_detail::error_norm2(s, inc, err, err_scale, noise_floor_);
       error_finite = e2 < std::numeric_limits<double>::infinity();
       if (e2 <= 1.0) {
         for (std::size_t j = 0; j < s.q.size(); ++j) {
           if constexpr (Comp) {
-            compensated_add(s.q[j], ccq[j], inc.q[j]);
-            compensated_add(s.v[j], ccv[j], inc.v[j]);
+            if (precise) {
+              add_increment(s.q[j], ccq[j], inc.q[j], low.q[j]);
+              add_increment(s.v[j], ccv[j], inc.v[j], low.v[j]);
+            } else {
+              compensated_add(s.q[j], ccq[j], inc.q[j]);
+              compensated_add(s.v[j], ccv[j], inc.v[j]);
+            }
           } else {
             s.q[j] += inc.q[j];
             s.v[j] += inc.v[j];
@@ -454,7 +487,8 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
     bool error_finite = true;
     constexpr bool local = fixed_lockstep;
     std::conditional_t<local, State<V>, State<V>&> s = s_io;
-    State<V> inc = s_io, err = s_io, inc_lo = s_io, err_lo = s_io;
+    State<V> inc = s_io, err = s_io, inc_lo = s_io, err_lo = s_io, low = s_io, low_lo = s_io;
+    const bool precise = Comp && precise_products();
     if (!local) resize_buffers(s_io);
     if (Comp) comp_.begin(s_io);
     std::conditional_t<local, V, V&> ccq = comp_.cq, ccv = comp_.cv;
@@ -494,7 +528,8 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
       bool early_reject = false;
       auto check = [&](const auto& x) -> bool {
         if (n - 1 < 2) return true;
-        oc_combine(static_cast<std::size_t>(n - 1), x, inc_lo, err_lo);
+        this->template oc_combine<std::remove_cvref_t<decltype(x)>::precise>(static_cast<std::size_t>(n - 1), x, inc_lo,
+                                                                             err_lo, low_lo);
         e2_lo = adaptive_detail::error_norm2(s, inc_lo, err_lo, err_scale, ocnoise_[static_cast<std::size_t>(n - 1)]);
         // Two products (order 4) have no lower estimate to weigh against: a step taken there could never raise the
         // order again (its step ratio is about 1 in a steady run, never fac_max), so the step completes product n.
@@ -510,27 +545,37 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
       };
       auto done = [&](const auto& x) {
         if (taken == 0 && !early_reject) {
-          oc_combine(static_cast<std::size_t>(n), x, inc, err);
+          this->template oc_combine<std::remove_cvref_t<decltype(x)>::precise>(static_cast<std::size_t>(n), x, inc, err,
+                                                                               low);
           e2 = adaptive_detail::error_norm2(s, inc, err, err_scale, ocnoise_[static_cast<std::size_t>(n)]);
           if (e2 <= 1.0) taken = n;
           if (n - 1 >= 2) elo = e2_lo;
           if (!taken && n - 1 == 2 && e2_lo <= 1.0) taken = n - 1;  // order 6 failed where order 4 passed
         } else if (n - 2 >= 2) {  // stopped after products 1..n-1: the estimate of order 2n - 4 as well
-          oc_combine(static_cast<std::size_t>(n - 2), x, inc, err);
+          this->template oc_combine<std::remove_cvref_t<decltype(x)>::precise>(static_cast<std::size_t>(n - 2), x, inc,
+                                                                               err, low);
           elo = adaptive_detail::error_norm2(s, inc, err, err_scale, ocnoise_[static_cast<std::size_t>(n - 2)]);
         }
       };
-      own_evals_ += oc_dispatch(n, s, a0, h, check, done);
+      own_evals_ += Kernels::template with_precision<Comp>(precise, [&](auto pr) NYSTROM_ALWAYS_INLINE {
+        return this->template oc_dispatch<decltype(pr)::value>(n, s, a0, h, check, done);
+      });
       // j: the highest order estimated (the one taken, or the last one computed); elo that of j - 1.
       const int j = (taken == n - 1 || early_reject) ? n - 1 : n;
       const double ej = j == n ? e2 : e2_lo;
       error_finite = std::isfinite(ej);
       const State<V>& inc_taken = taken == n ? inc : inc_lo;
+      const State<V>& low_taken = taken == n ? low : low_lo;
       if (taken) {
         for (std::size_t i = 0; i < s.q.size(); ++i) {
           if constexpr (Comp) {
-            compensated_add(s.q[i], ccq[i], inc_taken.q[i]);
-            compensated_add(s.v[i], ccv[i], inc_taken.v[i]);
+            if (precise) {
+              add_increment(s.q[i], ccq[i], inc_taken.q[i], low_taken.q[i]);
+              add_increment(s.v[i], ccv[i], inc_taken.v[i], low_taken.v[i]);
+            } else {
+              compensated_add(s.q[i], ccq[i], inc_taken.q[i]);
+              compensated_add(s.v[i], ccv[i], inc_taken.v[i]);
+            }
           } else {
             s.q[i] += inc_taken.q[i];
             s.v[i] += inc_taken.v[i];
