@@ -183,7 +183,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
       base_.force()(s.q, a0_);
       ++extra_evals_;
     }
-    State<V> low = s;
+    State<V> low = s;  // the increment's low part: unused, the products of a trial step are plain
     if (compensated_)
       this->template trial<true, false>(k_.size(), s, a0_, xs_, as_, cqs_, cvs_, inc, err, low);
     else
@@ -240,10 +240,29 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   using Kernels::scale;
   using Kernels::xs_;
 
-  // (x, cx) += (d, dl): the double-word increment of precise products added to the state and its carry (an exact
-  // two-sum, eft::add_double_word); the built-in floating types only (other types never run precise products).
-  static void add_increment(scalar_type& x, scalar_type& cx, const scalar_type& d, const scalar_type& dl) {
-    if constexpr (can_be_precise) eft::add_double_word(x, cx, d, dl);
+  // s += inc: with Comp, through the run's carries (ccq, ccv); with precise products the increment is the
+  // double-word inc + low, added by an exact two-sum (eft::add_double_word; the built-in floating types only,
+  // other types never run precise products).
+  template <bool Comp>
+  NYSTROM_ALWAYS_INLINE static void apply_increment(State<V>& s, V& ccq, V& ccv, const State<V>& inc,
+                                                    [[maybe_unused]] const State<V>& low,
+                                                    [[maybe_unused]] bool precise) {
+    for (std::size_t j = 0; j < s.q.size(); ++j) {
+      if constexpr (Comp) {
+        if constexpr (can_be_precise) {
+          if (precise) {
+            eft::add_double_word(s.q[j], ccq[j], inc.q[j], low.q[j]);
+            eft::add_double_word(s.v[j], ccv[j], inc.v[j], low.v[j]);
+            continue;
+          }
+        }
+        compensated_add(s.q[j], ccq[j], inc.q[j]);
+        compensated_add(s.v[j], ccv[j], inc.v[j]);
+      } else {
+        s.q[j] += inc.q[j];
+        s.v[j] += inc.v[j];
+      }
+    }
   }
 
   template <bool Comp, class Observer>
@@ -372,20 +391,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
       const double e2 = adaptive_detail::error_norm2(s, inc, err, err_scale, noise_floor_);
       error_finite = e2 < std::numeric_limits<double>::infinity();
       if (e2 <= 1.0) {
-        for (std::size_t j = 0; j < s.q.size(); ++j) {
-          if constexpr (Comp) {
-            if (precise) {
-              add_increment(s.q[j], ccq[j], inc.q[j], low.q[j]);
-              add_increment(s.v[j], ccv[j], inc.v[j], low.v[j]);
-            } else {
-              compensated_add(s.q[j], ccq[j], inc.q[j]);
-              compensated_add(s.v[j], ccv[j], inc.v[j]);
-            }
-          } else {
-            s.q[j] += inc.q[j];
-            s.v[j] += inc.v[j];
-          }
-        }
+        apply_increment<Comp>(s, ccq, ccv, inc, low, precise);
         a0_valid = false;
         t = last ? t1 : t + h;
         ++accepted;
@@ -567,20 +573,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
       const State<V>& inc_taken = taken == n ? inc : inc_lo;
       const State<V>& low_taken = taken == n ? low : low_lo;
       if (taken) {
-        for (std::size_t i = 0; i < s.q.size(); ++i) {
-          if constexpr (Comp) {
-            if (precise) {
-              add_increment(s.q[i], ccq[i], inc_taken.q[i], low_taken.q[i]);
-              add_increment(s.v[i], ccv[i], inc_taken.v[i], low_taken.v[i]);
-            } else {
-              compensated_add(s.q[i], ccq[i], inc_taken.q[i]);
-              compensated_add(s.v[i], ccv[i], inc_taken.v[i]);
-            }
-          } else {
-            s.q[i] += inc_taken.q[i];
-            s.v[i] += inc_taken.v[i];
-          }
-        }
+        apply_increment<Comp>(s, ccq, ccv, inc_taken, low_taken, precise);
         a0_valid = false;
         t = last ? t1 : t + h;
         ++accepted;

@@ -72,16 +72,11 @@ class MpeKernels {
     return f(std::false_type{});
   }
 
-  // x += y; precise: the rounding error of the addition into the carry c.
-  template <bool Precise>
-  NYSTROM_ALWAYS_INLINE static void accumulate(scalar_type& x, scalar_type& c, const scalar_type& y) {
-    if constexpr (Precise) {
-      scalar_type e;
-      x = eft::two_sum(x, y, e);
-      c += e;
-    } else {
-      x += y;
-    }
+  // x += y, the rounding error of the addition into the carry c (Knuth's two-sum; precise products only).
+  NYSTROM_ALWAYS_INLINE static void add_with_carry(scalar_type& x, scalar_type& c, const scalar_type& y) {
+    scalar_type e;
+    x = eft::two_sum(x, y, e);
+    c += e;
   }
 
   MpeKernels(std::vector<long> k, std::vector<scalar_type> c, std::vector<scalar_type> d,
@@ -246,7 +241,7 @@ class MpeKernels {
     auto drift = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
       State<V>& y = x[r];
       if constexpr (precise) {
-        for (std::size_t j = 0; j < n; ++j) accumulate<true>(y.q[j], cx[r][j], c * (s.v[j] + y.v[j]));
+        for (std::size_t j = 0; j < n; ++j) add_with_carry(y.q[j], cx[r][j], c * (s.v[j] + y.v[j]));
       } else {
         for (std::size_t j = 0; j < n; ++j) y.q[j] += c * (s.v[j] + y.v[j]);
       }
@@ -265,7 +260,7 @@ class MpeKernels {
     auto kick = [&](std::size_t r, const scalar_type& c, const V& ar) NYSTROM_ALWAYS_INLINE {
       State<V>& y = x[r];
       if constexpr (precise) {
-        for (std::size_t j = 0; j < n; ++j) accumulate<true>(y.v[j], cy[r][j], c * ar[j]);
+        for (std::size_t j = 0; j < n; ++j) add_with_carry(y.v[j], cy[r][j], c * ar[j]);
       } else {
         for (std::size_t j = 0; j < n; ++j) y.v[j] += c * ar[j];
       }
@@ -360,14 +355,14 @@ class MpeKernels {
     };
     auto drift = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
       if constexpr (precise) {
-        for (std::size_t j = 0; j < D; ++j) accumulate<true>(dq[r][j], cq[r][j], c * (s.v[j] + dv[r][j]));
+        for (std::size_t j = 0; j < D; ++j) add_with_carry(dq[r][j], cq[r][j], c * (s.v[j] + dv[r][j]));
       } else {
         for (std::size_t j = 0; j < D; ++j) dq[r][j] += c * (s.v[j] + dv[r][j]);
       }
     };
     auto kick = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
       if constexpr (precise) {
-        for (std::size_t j = 0; j < D; ++j) accumulate<true>(dv[r][j], cv[r][j], c * a[r][j]);
+        for (std::size_t j = 0; j < D; ++j) add_with_carry(dv[r][j], cv[r][j], c * a[r][j]);
       } else {
         for (std::size_t j = 0; j < D; ++j) dv[r][j] += c * a[r][j];
       }
@@ -528,14 +523,14 @@ class MpeKernels {
     };
     auto drift = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
       if constexpr (precise) {
-        for (std::size_t j = 0; j < n; ++j) accumulate<true>(x.q(r, j), x.cq(r, j), c * (s.v[j] + x.v(r, j)));
+        for (std::size_t j = 0; j < n; ++j) add_with_carry(x.q(r, j), x.cq(r, j), c * (s.v[j] + x.v(r, j)));
       } else {
         for (std::size_t j = 0; j < n; ++j) x.q(r, j) += c * (s.v[j] + x.v(r, j));
       }
     };
     auto kick = [&](std::size_t r, const scalar_type& c) NYSTROM_ALWAYS_INLINE {
       if constexpr (precise) {
-        for (std::size_t j = 0; j < n; ++j) accumulate<true>(x.v(r, j), x.cv(r, j), c * x.acc(r, j));
+        for (std::size_t j = 0; j < n; ++j) add_with_carry(x.v(r, j), x.cv(r, j), c * x.acc(r, j));
       } else {
         for (std::size_t j = 0; j < n; ++j) x.v(r, j) += c * x.acc(r, j);
       }
