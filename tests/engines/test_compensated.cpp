@@ -283,6 +283,10 @@ SecondOrderProblem<V, CompensatedKeplerForce> compensated_kepler(double ecc, dou
   return SecondOrderProblem(CompensatedKeplerForce{}, s0.q, s0.v, 0.0, t1);
 }
 
+// The end of a backward run from the apocentre on the x axis, mirrored in the x axis: the forward orbit's end at
+// the same |t|.
+State<V> mirrored_in_x_axis(const State<V>& s) { return State<V>{{s.q[0], -s.q[1]}, {-s.v[0], s.v[1]}}; }
+
 // The run of prob (span [0, t1]) with opt, and the same run checkpointed at 0.41 t1 and resumed: both end bitwise
 // where the first does, with the same step count. Returns the uninterrupted run.
 template <class F>
@@ -356,10 +360,7 @@ TEST(Compensated, CompensatedForceRunRestartsBitwiseBothDirections) {
     const KeplerProblem<double> kp(0.7);
     const State<V> s0 = kp.initial_state();
     State<V> end{plain.q_final, plain.v_final};
-    if (t1 < 0) {  // the orbit from the apocentre on the x axis at -t is that at +t mirrored in the x axis
-      end.q = {end.q[0], -end.q[1]};
-      end.v = {-end.v[0], end.v[1]};
-    }
+    if (t1 < 0) end = mirrored_in_x_axis(end);
     EXPECT_LT(kepler_reference_errors(s0, end, 30.0, 1).position, 1e-12);
   }
 }
@@ -382,10 +383,7 @@ TEST(Compensated, PreciseProductsRunRestartsBitwiseBothDirections) {
     const auto plain = expect_restart_is_bitwise(SecondOrderProblem(KeplerForce{}, s0.q, s0.v, 0.0, t1), def, opt, t1);
     EXPECT_GT(plain.accepted, 200);
     State<V> end{plain.q_final, plain.v_final};
-    if (t1 < 0) {  // mirrored in the x axis, as above
-      end.q = {end.q[0], -end.q[1]};
-      end.v = {-end.v[0], end.v[1]};
-    }
+    if (t1 < 0) end = mirrored_in_x_axis(end);
     EXPECT_LT(kepler_reference_errors(s0, end, 30.0, 1).position, 1e-12);
   }
 }
@@ -414,10 +412,7 @@ SplitErrors fixed_step_errors(const std::string& method, double ecc, long spp, b
     end.q[i] += integ.compensator().cq[i];
     end.v[i] += integ.compensator().cv[i];
   }
-  if (backward) {
-    end.q = {end.q[0], -end.q[1]};
-    end.v = {-end.v[0], end.v[1]};
-  }
+  if (backward) end = mirrored_in_x_axis(end);
   const auto e = kepler_reference_errors(s0, end, h, n);
   return {e.position, e.velocity};
 }
