@@ -30,13 +30,14 @@ class OdeResult(AttrDict):
 
     Attributes: ``t`` (output times), ``q``, ``v`` (positions and velocities, shape ``(len(t),) +
     q0.shape``), ``force_evals`` (by the method), ``output_force_evals`` (for output times, events and the
-    dense output), ``steps``, ``rejected``, ``status`` (0: reached the end of t_span, 1: a terminal event,
-    -1: failure: step size underflow, too many steps or a state no longer finite; ``t``, ``q``, ``v`` then hold
-    the states saved before it), ``message``, ``success``, ``sol`` (a :class:`DenseSolution` when
-    ``dense_output=True``), ``t_events``, ``q_events``, ``v_events`` (one array per event function),
-    ``method``, ``precision``, ``h`` (fixed steps: the step size), ``q_str``/``v_str`` (the final state in
-    full working precision, as decimal strings), ``solve_seconds`` (wall time of the library's solve() call),
-    ``checkpoint_t`` (the time of the checkpoint written, or None).
+    dense output), ``steps``, ``rejected``, ``precise_products`` (adaptive multi-product methods: whether the
+    products carried their own rounding, as at tight tolerances; False for every other method), ``status`` (0:
+    reached the end of t_span, 1: a terminal event, -1: failure: step size underflow, too many steps or a state
+    no longer finite; ``t``, ``q``, ``v`` then hold the states saved before it), ``message``, ``success``,
+    ``sol`` (a :class:`DenseSolution` when ``dense_output=True``), ``t_events``, ``q_events``, ``v_events`` (one
+    array per event function), ``method``, ``precision``, ``h`` (fixed steps: the step size), ``q_str``/``v_str``
+    (the final state in full working precision, as decimal strings), ``solve_seconds`` (wall time of the
+    library's solve() call), ``checkpoint_t`` (the time of the checkpoint written, or None).
     """
 
     def __repr__(self):
@@ -472,6 +473,7 @@ def solve(force, q0=None, v0=None, t_span=None, method="M8", h=None, steps=None,
     res.output_force_evals = int(d["output_force_evals"])
     res.steps = int(d["steps"])
     res.rejected = int(d["rejected"])
+    res.precise_products = bool(d["precise_products"])
     res.status = int(d["status"])
     res.message = d["message"]
     res.success = res.status >= 0

@@ -288,6 +288,7 @@ py::dict run_solve(F force, const SolveRequest& r, bool python_force, long mpfr_
   d["output_force_evals"] = sol.output_force_evals;
   d["steps"] = sol.accepted;
   d["rejected"] = sol.rejected;
+  d["precise_products"] = sol.precise_products;
   d["status"] = status;
   d["message"] = message;
   d["checkpoint_t"] = sol.checkpoint ? py::object(py::float_(as_double(sol.checkpoint->t))) : py::object(py::none());

@@ -139,6 +139,26 @@ def test_adaptive_methods_reach_their_tolerance():
         assert tighter.force_evals > res.force_evals
 
 
+@pytest.mark.parametrize("method", ["M12-adaptive", "M16-adaptive"])
+def test_precise_products_are_reported_from_the_methods_calibration(method):
+    # The products of an adaptive multi-product run in double carry their own rounding when the controlled
+    # tolerance anchor (tol / anchor)^gamma is at most 1e4 eps: up to the user tolerance
+    # tol* = anchor (1e4 eps / anchor)^(1/gamma) from the method's calibration. Both time directions; never in long
+    # double (no compensation), for an RKN pair or with fixed steps.
+    info = nystrom.method_info(method)
+    anchor, gamma = info["tolerance_anchor"], info["tolerance_exponent"]
+    tstar = anchor * (1e4 * np.finfo(float).eps / anchor) ** (1 / gamma)
+    prob = Kepler(0.5)
+    for t1 in (2.0, -2.0):
+        below = nystrom.solve(prob, t_span=(0, t1), method=method, rtol=0.99 * tstar, t_eval=[t1])
+        above = nystrom.solve(prob, t_span=(0, t1), method=method, rtol=1.01 * tstar, t_eval=[t1])
+        assert below.precise_products is True and above.precise_products is False, (t1, tstar)
+        wide = nystrom.solve(prob, t_span=(0, t1), method=method, rtol=0.99 * tstar, precision="long-double")
+        assert wide.precise_products is False
+    assert nystrom.solve(prob, t_span=(0, 2), method="DP12-adaptive", rtol=1e-13).precise_products is False
+    assert nystrom.solve(prob, t_span=(0, 2), method="M12", steps=20).precise_products is False
+
+
 def test_t_eval_lands_on_each_time():
     prob = Kepler(0.3)
     te = np.linspace(0.5, 9.5, 7)

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <complex>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,7 @@ void expect_bitwise(const Solution<Vd>& a, const Solution<Vd>& b) {
   EXPECT_EQ(a.output_force_evals, b.output_force_evals);
   EXPECT_EQ(a.accepted, b.accepted);
   EXPECT_EQ(a.rejected, b.rejected);
+  EXPECT_EQ(a.precise_products, b.precise_products);
   ASSERT_EQ(a.events.size(), b.events.size());
   for (std::size_t i = 0; i < a.events.size(); ++i) EXPECT_TRUE(same_bits(a.events[i].t, b.events[i].t));
 }
@@ -104,6 +106,41 @@ TEST(Compiled, EveryCatalogMethodIsBitwiseTheInlinePathBothDirections) {
       EXPECT_LT(std::abs(a.q_final[0]) + std::abs(a.q_final[1]), 10.0);  // a real orbit, not garbage
     }
   }
+}
+
+// An adaptive multi-product run reports whether its products carried their own rounding (Solution::precise_products):
+// in double with compensation, when the controlled tolerance anchor (tol / anchor)^gamma (the method's calibration)
+// is at most 1e4 eps, i.e. at user tolerances up to tol* = anchor (1e4 eps / anchor)^(1 / gamma) (9.0e-12 for
+// M12-adaptive). Both time directions, the compiled and the inline path, a run resumed from a checkpoint; never for
+// an RKN pair or without compensation.
+TEST(Compiled, PreciseProductsAreReportedFromTheMethodsCalibration) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  for (const std::string m : {"M12-adaptive", "M16-adaptive"}) {
+    const MethodDef d = resolve_solve_method(m);
+    const double anchor = d.info.tolerance_anchor, gamma = d.info.tolerance_exponent;
+    ASSERT_GT(anchor, 0) << m;
+    ASSERT_TRUE(gamma > 0.5 && gamma < 1) << m;
+    const double tstar = anchor * std::pow(1e4 * eps / anchor, 1 / gamma);
+    for (const double t1 : {2.0, -2.0}) {
+      SCOPED_TRACE(m + (t1 > 0 ? " forward" : " backward"));
+      const auto prob = kepler_vec(0.0, t1);
+      SolveOptions opt{.rtol = 0.99 * tstar};
+      opt.checkpoint_at = 0.5 * t1;
+      const auto below = solve(prob, d, opt);
+      EXPECT_TRUE(below.precise_products) << "tol " << opt.rtol;
+      expect_bitwise(below, solve_inline(prob, d, opt));
+      ASSERT_TRUE(below.checkpoint.has_value());
+      opt.checkpoint_at = std::numeric_limits<double>::quiet_NaN();
+      EXPECT_TRUE(resume(prob, d, *below.checkpoint, opt).precise_products);
+      opt.rtol = 1.01 * tstar;
+      EXPECT_FALSE(solve(prob, d, opt).precise_products) << "tol " << opt.rtol;
+      opt.rtol = 1e-13;
+      opt.compensated = Compensation::off;
+      EXPECT_FALSE(solve(prob, d, opt).precise_products) << "without compensation";
+    }
+  }
+  EXPECT_FALSE(solve(kepler_vec(0.0, 2.0), "DP12-adaptive", {.rtol = 1e-13}).precise_products);
+  EXPECT_FALSE(solve(kepler_vec(0.0, 2.0), "M12", {.steps = 20}).precise_products);
 }
 
 TEST(Compiled, TimeDependentForceOutputTimesEventsAndCheckpointsAreBitwiseTheInlinePath) {

@@ -9,6 +9,7 @@
 //   sol(t)                      the state at any t of the span (dense output, solve/dense.hpp)
 //   sol.events                  located events (Event: g(t, q, v) = 0, direction, terminal)
 //   sol.force_evals, sol.accepted, sol.rejected, sol.status, sol.message
+//   sol.precise_products        adaptive multi-product methods: the products carried their own rounding
 //
 // solve() chooses the engine from the method once: splitting, RKN and multi-product methods with fixed
 // steps; adaptive RKN pairs and adaptive multi-product methods with a tolerance; GBS. Complex-coefficient
@@ -621,6 +622,7 @@ void run_adaptive(Run<V, F, VE>& run, Engine& engine, const long& calls, const c
     rej0 = resume->rejected;
     sol.output_force_evals = resume->output_force_evals;
   }
+  if constexpr (requires { engine.precise_products(); }) sol.precise_products = engine.precise_products();
   Recorder<V, SecondOrderProblem<V, F>> rec(prob, run.opt, events, sol, dir,
                                             needs_partial_steps(run.opt, events, resume ? resume->t : prob.t0, prob.t1)
                                                 ? run.propagated_method(def)

@@ -49,6 +49,10 @@ struct Solution {
                                 // (a failed run: those up to the failure)
   long output_force_evals = 0;  // at step ends for the dense output and events
   long accepted = 0, rejected = 0;
+  /// Adaptive multi-product methods: whether the products carried their own rounding (precise products: a run in
+  /// float or double whose controlled tolerance is at most 1e4 eps, e.g. M12-adaptive at tolerances of 9e-12 and
+  /// below; AdaptiveMpeIntegrator::precise_products). False for every other method.
+  bool precise_products = false;
   SolveStatus status = SolveStatus::success;
   std::string message;
   std::vector<EventHit<V>> events;
