@@ -18,17 +18,16 @@
 namespace {
 
 // The report of one run as a table. The step of an adaptive method is the mean accepted step (span / steps).
-void print_report(const nystrom::cli::RunReport& r, bool adaptive, long rejected = -1) {
+void print_report(const nystrom::cli::RunReport& r, bool adaptive) {
   fmt::print("method            {} ({}, order {})\n", r.method, r.family, r.order);
   fmt::print("problem           {}{}\n", r.problem, r.problem == "kepler" ? fmt::format(" e = {}", r.ecc) : "");
   fmt::print("precision         {}\n", r.precision);
   if (!adaptive)
     fmt::print("steps             {} (h = {:.6g})\n", r.steps, r.h);
-  else if (rejected >= 0)
-    fmt::print("steps             {} accepted, {} rejected (mean h = {:.6g})\n", r.steps, rejected, r.h);
   else
-    fmt::print("steps             {} accepted (mean h = {:.6g})\n", r.steps, r.h);
+    fmt::print("steps             {} accepted, {} rejected (mean h = {:.6g})\n", r.steps, r.rejected, r.h);
   fmt::print("force evaluations {}\n", r.force_evals);
+  if (r.precise_products) fmt::print("products          precise (each carries its own rounding)\n");
   if (r.problem == "kepler") fmt::print("precession/period {:+.6e} rad\n", r.precession_per_period);
   if (r.problem == "nbody") fmt::print("(position error against a GBS reference run at tolerance 1e-13)\n");
   fmt::print("energy error      {:.6e} (relative)\n", r.energy_error);
@@ -172,7 +171,7 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
         for (const auto& [k, v] : r.extra.items()) j[k] = v;
         std::cout << j.dump(2) << "\n";
       } else {
-        print_report(r.report, adaptive, adaptive ? r.extra.at("rejected").get<long>() : -1);
+        print_report(r.report, adaptive);
         print_solve_extra(r.extra);
       }
       return 0;

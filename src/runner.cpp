@@ -71,6 +71,10 @@ nlohmann::json RunReport::to_json() const {
                    {"position_error", num(position_error)},
                    {"seconds", num(seconds)}};
   if (!force.empty()) j["force"] = force;
+  if (adaptive) {
+    j["rejected"] = rejected;
+    j["precise_products"] = precise_products;
+  }
   if (!q.empty()) {  // the final state, each number to 17 significant digits (it reads back to the same double)
     j["t"] = num(t);
     j["q"] = q;
@@ -120,6 +124,9 @@ RunReport run_nbody_case(const RunRequest& req, const MethodDef& def) {
   out.ecc = req.problem == "twobody" ? req.ecc : RunReport::nan;
   out.steps = r.steps;
   out.force_evals = r.force_evals;
+  out.adaptive = def.info.adaptive;
+  out.rejected = r.rejected;
+  out.precise_products = r.precise_products;
   out.h = r.h;
   out.energy_error = r.energy_error;
   out.position_error = r.position_error;

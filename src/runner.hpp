@@ -92,6 +92,11 @@ struct RunReport {
   double ecc = nan;
   long steps = 0;
   long force_evals = 0;
+  // Adaptive methods and GBS (JSON keys `rejected`, `precise_products` when adaptive is set): the rejected steps, and
+  // whether the products of an adaptive multi-product method carried their own rounding (Solution::precise_products)
+  bool adaptive = false;
+  long rejected = 0;
+  bool precise_products = false;
   double h = nan;
   double precession_per_period = nan;  // Kepler: signed LRL rotation per period (rad), CCW positive
   double energy_error = nan;           // relative energy error at the end

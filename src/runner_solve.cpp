@@ -108,7 +108,6 @@ SolveRunResult run_kepler_solve(const RunRequest& req, const SolveRequest& sreq,
   extra["q"] = vec(sol.q_final);
   extra["v"] = vec(sol.v_final);
   extra["output_force_evals"] = sol.output_force_evals;
-  extra["rejected"] = sol.rejected;
   if (!sreq.output_times.empty()) {
     auto out = nlohmann::json::array();
     for (std::size_t i = 0; i < sol.t.size(); ++i)

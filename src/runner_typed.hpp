@@ -89,6 +89,9 @@ OrbitRun<T, N> run_orbit_with(const RunRequest& req, const MethodDef& def,
   label_report(r, req, def);
   r.steps = sol.accepted;
   r.force_evals = sol.force_evals;
+  r.adaptive = adaptive;
+  r.rejected = sol.rejected;
+  r.precise_products = sol.precise_products;
   r.seconds = std::chrono::duration<double>(w1 - w0).count();
   // The exact end time is h n (problems/reference.hpp): n steps of the span over n, or one adaptive run.
   const T h = adaptive ? t_end : T(t_end / T(n));

@@ -25,6 +25,8 @@ struct NBodyRunResult {
   std::string method;
   long steps = 0;
   long force_evals = 0;
+  long rejected = 0;              // adaptive methods and GBS: the rejected steps
+  bool precise_products = false;  // adaptive multi-product methods: Solution::precise_products
   double h = 0;
   double energy_error = 0;    // |E - E0| / |E0|
   double position_error = 0;  // max over components of |q - q_ref|
@@ -74,6 +76,8 @@ NBodyRunResult run_nbody(const std::string& method, const NBodySetup& setup, dou
   r.method = def.info.name;
   r.force_evals = sol.force_evals;
   r.steps = sol.accepted;
+  r.rejected = sol.rejected;
+  r.precise_products = sol.precise_products;
   r.h = span / static_cast<double>(std::max(1L, sol.accepted));  // fixed steps: the step solve() takes
   const State<std::vector<double>> s{sol.q_final, sol.v_final};
   const double e0 = nbody_energy(inst.force, s0);

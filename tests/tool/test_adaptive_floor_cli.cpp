@@ -16,6 +16,9 @@
 //   * at those tolerances the step count grows as tol^(-1/(p+1)), p the order of the error estimate (at most 1.5
 //     times that from tolerance 1e-13): a step that shrinks into the noise of the estimate grows it much faster
 //     (M16-adaptive before its estimate was floored at its round-off: 1762 steps at 1e-13, 5742 at 3.2e-15).
+//   * every run's cost adds up: force evaluations = per step x (accepted + rejected) + 2 (the starting step), and
+//     the JSON's precise_products is true exactly where the method's calibration puts the controlled tolerance at
+//     1e4 eps or below (the multi-product methods; never an RKN pair).
 // The tolerance below the tightest is refused with a one-line error. The tool is found through NYSTROM_BIN.
 #include <gtest/gtest.h>
 
@@ -38,7 +41,8 @@ using namespace cli_test;
 
 struct Point {
   double tol, error;
-  long steps;
+  long steps, rejected = 0, force_evals = 0;
+  bool precise_products = false;
 };
 
 std::string tol_text(double tol) {
@@ -62,7 +66,8 @@ std::vector<Point> sweep_command(const std::string& command, const char* error_k
       break;
     }
     const auto j = nlohmann::json::parse(r.out);
-    pts.push_back({tol, j.at(error_key).get<double>(), j.at("steps").get<long>()});
+    pts.push_back({tol, j.at(error_key).get<double>(), j.at("steps").get<long>(), j.value("rejected", -1L),
+                   j.value("force_evals", -1L), j.value("precise_products", false)});
   }
   return pts;
 }
@@ -103,12 +108,55 @@ ToleranceRatios decade_ratios(const std::vector<Point>& pts, double proportional
   return r;
 }
 
+// What the cost and the arithmetic of an adaptive run follow from: the force evaluations per step, the family and the
+// controller's calibration (tolerance exponent gamma and anchor). A catalog method's come from `nystrom methods
+// --json`; M<p>-adaptive (a specification, not in the list) is the multi-product expansion of the natural sequence
+// k_i = i, i = 1..p/2, over the symmetric base: sum k_i = n (n + 1) / 2 forces per step (the products share nothing),
+// and an error estimate of order p - 2, so gamma = (p - 1) / (p + 1), with the default anchor 1e-15.
+struct AdaptiveInfo {
+  long per_step = 0;
+  bool mpe = false;
+  double gamma = 0, anchor = 0;
+};
+AdaptiveInfo adaptive_info(const std::string& method) {
+  const auto r = run("methods --json");
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const auto& m : nlohmann::json::parse(r.out))
+    if (m.at("name") == method)
+      return {m.at("force_evals_per_step").get<long>(), m.at("family") == "mpe",
+              m.at("tolerance_exponent").get<double>(), m.at("tolerance_anchor").get<double>()};
+  int p = 0;
+  EXPECT_EQ(std::sscanf(method.c_str(), "M%d-adaptive", &p), 1) << method;
+  const long n = p / 2;
+  return {n * (n + 1) / 2, true, (p - 1.0) / (p + 1.0), 1e-15};
+}
+
+// The cost the controller decided and how the run added: every step, accepted or rejected, costs the method's force
+// evaluations per step, and the starting step (Hairer's) two more; an adaptive multi-product run's products carry
+// their own rounding (precise_products) exactly at the tolerances whose controlled tolerance anchor (tol /
+// anchor)^gamma is at most 1e4 eps (M12-adaptive from 9.0e-12 down), an RKN pair's never.
+void check_cost_and_products(const std::string& method, const std::vector<Point>& pts) {
+  const AdaptiveInfo info = adaptive_info(method);
+  const double tstar =
+      info.anchor * std::pow(1e4 * std::numeric_limits<double>::epsilon() / info.anchor, 1 / info.gamma);
+  long rejected = 0;
+  for (const auto& q : pts) {
+    EXPECT_GE(q.rejected, 0) << method << " tol " << q.tol;
+    EXPECT_EQ(q.force_evals, info.per_step * (q.steps + q.rejected) + 2) << method << " tol " << q.tol;
+    EXPECT_EQ(q.precise_products, info.mpe && q.tol <= tstar) << method << " tol " << q.tol << ", tol* " << tstar;
+    rejected += q.rejected;
+  }
+  EXPECT_GT(rejected, 0) << method << ": a sweep over Kepler's pericentres rejects some steps";
+  EXPECT_EQ(pts.back().precise_products, info.mpe) << method << " at the tightest tolerance";
+}
+
 // amplification: A above; p: the order of the error estimate; falls: assert the fall above the floor;
 // proportional_to: the tightest tolerance of the proportionality check (below it the rounding floor sets the error).
 void check(const std::string& method, double ecc, double amplification, int p, bool falls = true,
            double proportional_to = 0) {
   const auto pts = sweep(method, ecc);
   ASSERT_GE(pts.size(), 30u) << method << ": the tool accepts tolerances down to about 1e-14 at least";
+  check_cost_and_products(method, pts);
   const double eps = std::numeric_limits<double>::epsilon();
   const double span = 200 * std::numbers::pi;
   auto bound = [&](const Point& q) { return amplification * eps * std::sqrt(static_cast<double>(q.steps)) * span; };
