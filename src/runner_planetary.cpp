@@ -51,6 +51,7 @@ struct Outcome {
   std::string method, family;
   int order = 0;
   long steps = 0, force_evals = 0, kepler_drifts = 0;
+  long rejected = 0;  // adaptive direct methods
   double energy_error = 0, energy_error_max = 0, angular_momentum_error = 0, seconds = 0, cpu_seconds = 0;
   Vec3<long double> jupiter{};
 };
@@ -128,6 +129,7 @@ Outcome run_direct(const MethodDef& def, double h, long steps, double tol) {
   o.order = def.info.order;
   o.steps = def.info.adaptive ? sol.accepted : steps;
   o.force_evals = sol.force_evals;
+  o.rejected = sol.rejected;
   PlanetarySystem<double> end = sys;
   unflatten(sol.q_final, end.x);
   unflatten(sol.v_final, end.v);
@@ -204,6 +206,7 @@ nlohmann::json run_planetary(const PlanetaryRequest& req) {
                    {"steps", o.steps},
                    {"force_evals", o.force_evals},
                    {"kepler_drifts", o.kepler_drifts},
+                   {"rejected", o.rejected},
                    {"energy_error", num(o.energy_error)},
                    {"energy_error_max", num(o.energy_error_max)},
                    {"angular_momentum_error", num(o.angular_momentum_error)},
@@ -237,7 +240,8 @@ void print_planetary(const nlohmann::json& r) {
   fmt::print("precision              {}\n", r["precision"].get<std::string>());
   const long steps = r["steps"].get<long>();
   if (r.value("adaptive", false))  // the span is a whole number of --h days
-    fmt::print("steps                  {} (mean h = {:.6g} days, {:.6g} years)\n", steps,
+    fmt::print("steps                  {} accepted, {} rejected (mean h = {:.6g} days, {:.6g} years)\n", steps,
+               r.value("rejected", 0L),
                d("h") * std::round(d("years") * kDaysPerYear / d("h")) / static_cast<double>(steps > 0 ? steps : 1),
                d("years"));
   else

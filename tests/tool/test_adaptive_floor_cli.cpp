@@ -214,20 +214,29 @@ TEST(AdaptiveFloorCli, M16AdaptiveEccentricity09) { check("M16-adaptive", 0.9, m
 // Tolerance proportionality on the outer solar system (`--problem outer-solar-system`, 100 Jupiter periods, the
 // error of Jupiter's position against the tool's long-double reference): the largest error / tol of each decade of
 // tolerances from 1e-6 to 1e-13 stays within one decade, for DP12-adaptive and M12-adaptive (with tol itself:
-// 0.9 and 1.7 decades over 1e-6..1e-15, in long double).
+// 0.9 and 1.7 decades over 1e-6..1e-15, in long double); each run's force evaluations are its accepted and rejected
+// steps' (JSON `rejected`) plus the starting step's two.
 TEST(AdaptiveFloorCli, OuterSolarSystemErrorFollowsTheTolerance) {
+  long rejected = 0;  // over both sweeps (DP12-adaptive rejects a few steps, M12-adaptive none here)
   for (const std::string method : {"DP12-adaptive", "M12-adaptive"}) {
     const auto pts = sweep_command("run --problem outer-solar-system --years 1186 --h 100 --method " + method,
                                    "jupiter_position_error", 24, 51);
     ASSERT_EQ(pts.size(), 28u) << method << ": every tolerance from 1e-6 to 1.8e-13 accepted";
     for (const auto& q : pts)
       std::printf("[ oss   ] %-14s tol %-11.4g error %.3e steps %ld\n", method.c_str(), q.tol, q.error, q.steps);
+    // Every step, accepted or rejected, costs the method's force evaluations per step (and the starting step two).
+    const long per_step = adaptive_info(method).per_step;
+    for (const auto& q : pts) {
+      EXPECT_EQ(q.force_evals, per_step * (q.steps + q.rejected) + 2) << method << " tol " << q.tol;
+      rejected += q.rejected;
+    }
     const ToleranceRatios r = decade_ratios(pts, 1e-13);
     std::printf("[ oss   ] %-14s largest error / tol per decade: %.2e .. %.2e\n", method.c_str(), r.lo, r.hi);
     EXPECT_EQ(r.decades, 7) << method;
     EXPECT_LE(r.hi, 10 * r.lo) << method << ": error / tol within one decade";
     for (std::size_t i = 4; i < pts.size(); ++i) EXPECT_GT(pts[i].steps, pts[i - 4].steps) << method;
   }
+  EXPECT_GT(rejected, 0) << "the force counts must be checked on runs with rejected steps too";
 }
 
 // With the compensated Kepler force (--force compensated: the force in double-word, CompensatedKeplerForce) the

@@ -213,21 +213,22 @@ TEST(Cli, NBodyTwoBodyAndGbsRuns) {
 }
 
 TEST(Cli, OuterSolarSystemLabelsTheMeanStepOfAnAdaptiveMethod) {
-  // An adaptive direct method: --h sets only the span (a whole number of --h days); the table gives the mean
-  // accepted step and says so. A fixed-step one gives its step.
+  // An adaptive direct method: --h sets only the span (a whole number of --h days); the table gives the accepted and
+  // rejected steps and the mean accepted step and says so, as JSON does. A fixed-step one gives its step.
   const auto a = run("run --problem outer-solar-system --method DP12-adaptive --tol 1e-10 --years 100 --no-reference");
   ASSERT_EQ(a.code, 0) << a.err;
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(a.out, m, std::regex(R"(\nsteps +(\d+) \(mean h = (\S+) days, 100 years\)\n)")))
+  ASSERT_TRUE(std::regex_search(
+      a.out, m, std::regex(R"(\nsteps +(\d+) accepted, (\d+) rejected \(mean h = (\S+) days, 100 years\)\n)")))
       << a.out;
-  const double steps = std::stod(m[1]), h = std::stod(m[2]);
+  const double steps = std::stod(m[1]), h = std::stod(m[3]);
   EXPECT_NEAR(h, 36500 / steps, 1e-5 * h);
   EXPECT_NE(h, 100.0);
-  EXPECT_EQ(nlohmann::json::parse(run("run --problem outer-solar-system --method DP12-adaptive --tol 1e-10 --years 100 "
-                                      "--no-reference --json")
-                                      .out)
-                .at("adaptive"),
-            true);
+  const auto j = nlohmann::json::parse(
+      run("run --problem outer-solar-system --method DP12-adaptive --tol 1e-10 --years 100 --no-reference --json").out);
+  EXPECT_EQ(j.at("adaptive"), true);
+  EXPECT_EQ(j.at("steps").get<long>(), std::stol(m[1]));
+  EXPECT_EQ(j.at("rejected").get<long>(), std::stol(m[2]));
   const auto f = run("run --problem outer-solar-system --method M8 --h 200 --years 100 --no-reference");
   ASSERT_EQ(f.code, 0) << f.err;
   EXPECT_NE(f.out.find("\nsteps                  183 (h = 200 days, 100 years)\n"), std::string::npos) << f.out;
