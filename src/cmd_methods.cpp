@@ -1,5 +1,8 @@
-// `nystrom methods [--json | --markdown]`: the catalog. `--markdown` writes the page docs/methods.md
-// (a test compares the committed page with this output).
+// `nystrom methods [SPEC...] [--json | --markdown]`: the catalog, or the records of the method specifications given
+// (any name `run --method` accepts: M12-adaptive, mpe:1,2,3, GBS:bulirsch:10, ...; the record Python's
+// nystrom.method_info returns). `--markdown` writes the page docs/methods.md (a test compares the committed page with
+// this output).
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -9,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "nystrom/core/error.hpp"
 #include "nystrom/methods/catalog.hpp"
 #include "nystrom/planetary/wisdom_holman.hpp"
 
@@ -97,7 +101,9 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
   for (const auto& d : cat) page += markdown_row(d.info);
   page +=
       "\n## Method specifications beyond the table\n\n"
-      "Every command that takes a method also accepts:\n\n"
+      "Every command that takes a method also accepts the forms below; `nystrom methods SPEC...` (with `--json`: the\n"
+      "fields of the catalog's JSON) and `nystrom.method_info(SPEC)` in Python print the record of any of them\n"
+      "(`nystrom methods M12-adaptive`).\n\n"
       "- `M<2n>`: the multi-product expansion of any even order 2n on position Verlet with the natural sequence\n"
       "  k = 1, 2, ..., n (Chin 2010, eqs 14-15); `M<2n>-adaptive` the same with an adaptive step.\n"
       "- `mpe:K1,K2,...` (position Verlet base), `mpe-vv:K1,K2,...` (velocity Verlet base), `mpe-adaptive:K1,K2,...`,\n"
@@ -141,42 +147,60 @@ std::string markdown_page(const std::vector<nystrom::MethodDef>& cat) {
   return page;
 }
 
-nystrom::cli::Registrar reg("methods", "List every method in the catalog", [](CLI::App& app) {
-  auto json = std::make_shared<bool>(false);
-  auto markdown = std::make_shared<bool>(false);
-  auto* json_flag = app.add_flag("--json", *json, "Print one JSON array");
-  app.add_flag("--markdown", *markdown, "Print the catalog page docs/methods.md")->excludes(json_flag);
-  return [json, markdown]() {
-    const auto cat = nystrom::listed_methods();
-    if (*markdown) {
-      std::cout << markdown_page(cat);
-      return 0;
-    }
-    if (*json) {
-      nlohmann::json arr = nlohmann::json::array();
-      for (const auto& d : cat) arr.push_back(info_json(d.info));
-      std::cout << arr.dump(2) << "\n";
-      return 0;
-    }
-    fmt::print("{:<12} {:<12} {:>5} {:>6} {:>6} {:>4} {:>4} {:>5} {:>4}  {}\n", "name", "family", "order", "stages",
-               "forces", "fsal", "sym", "sympl", "cplx", "source");
-    for (const auto& d : cat) {
-      const auto& m = d.info;
-      auto yn = [](bool b) { return b ? "yes" : "-"; };
-      fmt::print("{:<12} {:<12} {:>5} {:>6} {:>6} {:>4} {:>4} {:>5} {:>4}  {}\n", m.name, m.family, m.order, m.stages,
-                 m.forces_per_step, yn(m.fsal), yn(m.symmetric), yn(m.symplectic), yn(m.complex), m.source);
-    }
-    fmt::print(
-        "\nAlso: M<2n> (any even order), mpe:K1,K2,... (PV base), mpe-vv:K1,K2,..., adjoint:NAME, "
-        "GBS:SEQUENCE[:COLUMNS] (harmonic, romberg, bulirsch; 3 to 20 columns).\n");
-    fmt::print("Velocity-dependent forces a(t, q, v) run with: {} (every other method is for a(t, q)).\n",
-               join(nystrom::velocity_methods(), ", "));
-    fmt::print("\nPlanetary maps (run --problem outer-solar-system; also WH-NAME, WHD-NAME for catalog methods):\n");
-    for (const auto& m : planetary_maps())
-      fmt::print("{:<12} {:<12} {:>5} {:>6} {:>6}  {}\n", m.name, m.family, m.order, m.stages, m.forces_per_step,
-                 m.description);
-    return 0;
-  };
-});
+nystrom::cli::Registrar reg(
+    "methods", "List every method in the catalog, or describe the methods named", [](CLI::App& app) {
+      auto json = std::make_shared<bool>(false);
+      auto markdown = std::make_shared<bool>(false);
+      auto specs = std::make_shared<std::vector<std::string>>();
+      app.add_option(
+          "specs", *specs,
+          "Method specifications to describe (M12-adaptive, mpe:1,2,3, GBS:bulirsch:10, ...); none: the catalog");
+      auto* json_flag = app.add_flag("--json", *json, "Print one JSON array");
+      app.add_flag("--markdown", *markdown, "Print the catalog page docs/methods.md")->excludes(json_flag);
+      return [json, markdown, specs]() {
+        if (*markdown && !specs->empty())
+          throw nystrom::invalid_input("methods: --markdown prints the whole catalog, not named methods");
+        std::vector<nystrom::MethodInfo> infos;
+        if (specs->empty()) {
+          for (const auto& d : nystrom::listed_methods()) infos.push_back(d.info);
+        } else {
+          // the record of the method a run with this specification executes (solve()'s resolution)
+          for (const auto& spec : *specs) infos.push_back(nystrom::resolve_solve_method(spec).info);
+        }
+        if (*markdown) {
+          std::cout << markdown_page(nystrom::listed_methods());
+          return 0;
+        }
+        if (*json) {
+          nlohmann::json arr = nlohmann::json::array();
+          for (const auto& m : infos) arr.push_back(info_json(m));
+          std::cout << arr.dump(2) << "\n";
+          return 0;
+        }
+        std::size_t width = 12;  // the name column fits the longest name listed
+        for (const auto& m : infos) width = std::max(width, m.name.size());
+        fmt::print("{:<{}} {:<12} {:>5} {:>6} {:>6} {:>4} {:>4} {:>5} {:>4}  {}\n", "name", width, "family", "order",
+                   "stages", "forces", "fsal", "sym", "sympl", "cplx", "source");
+        for (const auto& m : infos) {
+          auto yn = [](bool b) { return b ? "yes" : "-"; };
+          fmt::print("{:<{}} {:<12} {:>5} {:>6} {:>6} {:>4} {:>4} {:>5} {:>4}  {}\n", m.name, width, m.family, m.order,
+                     m.stages, m.forces_per_step, yn(m.fsal), yn(m.symmetric), yn(m.symplectic), yn(m.complex),
+                     m.source);
+        }
+        if (!specs->empty()) return 0;
+        fmt::print(
+            "\nAlso: M<2n> and M<2n>-adaptive (any even order), mpe:K1,K2,... (PV base), mpe-vv:K1,K2,..., "
+            "mpe-adaptive:K1,K2,..., adjoint:NAME, GBS:SEQUENCE[:COLUMNS] (harmonic, romberg, bulirsch; 3 to 20 "
+            "columns); `nystrom methods SPEC` describes one.\n");
+        fmt::print("Velocity-dependent forces a(t, q, v) run with: {} (every other method is for a(t, q)).\n",
+                   join(nystrom::velocity_methods(), ", "));
+        fmt::print(
+            "\nPlanetary maps (run --problem outer-solar-system; also WH-NAME, WHD-NAME for catalog methods):\n");
+        for (const auto& m : planetary_maps())
+          fmt::print("{:<12} {:<12} {:>5} {:>6} {:>6}  {}\n", m.name, m.family, m.order, m.stages, m.forces_per_step,
+                     m.description);
+        return 0;
+      };
+    });
 
 }  // namespace

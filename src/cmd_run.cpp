@@ -18,11 +18,11 @@
 namespace {
 
 // The report of one run as a table. The step of an adaptive method is the mean accepted step (span / steps).
-void print_report(const nystrom::cli::RunReport& r, bool adaptive) {
+void print_report(const nystrom::cli::RunReport& r) {
   fmt::print("method            {} ({}, order {})\n", r.method, r.family, r.order);
   fmt::print("problem           {}{}\n", r.problem, r.problem == "kepler" ? fmt::format(" e = {}", r.ecc) : "");
   fmt::print("precision         {}\n", r.precision);
-  if (!adaptive)
+  if (!r.adaptive)
     fmt::print("steps             {} (h = {:.6g})\n", r.steps, r.h);
   else
     fmt::print("steps             {} accepted, {} rejected (mean h = {:.6g})\n", r.steps, r.rejected, r.h);
@@ -162,16 +162,14 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
       return 0;
     }
     nystrom::cli::check_work_budget(nystrom::cli::run_work_units(o->req, def), "run");
-    const bool adaptive = def.info.adaptive;  // GBS too: its h is then the mean accepted step
     if (o->sreq.any()) {
       const auto r = nystrom::cli::run_kepler_solve(o->req, o->sreq, def);
       if (o->json) {
         auto j = r.report.to_json();
-        j["adaptive"] = adaptive;
         for (const auto& [k, v] : r.extra.items()) j[k] = v;
         std::cout << j.dump(2) << "\n";
       } else {
-        print_report(r.report, adaptive);
+        print_report(r.report);
         print_solve_extra(r.extra);
       }
       return 0;
@@ -180,11 +178,10 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
     const auto r = nystrom::cli::run_case(o->req, def);
     if (o->json) {
       auto j = r.to_json();
-      j["adaptive"] = adaptive;
       std::cout << j.dump(2) << "\n";
       return 0;
     }
-    print_report(r, adaptive);
+    print_report(r);
     return 0;
   };
 });

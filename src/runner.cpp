@@ -58,6 +58,7 @@ RunReport run_in_precision(const RunRequest& req, const MethodDef& def);
 
 nlohmann::json RunReport::to_json() const {
   nlohmann::json j{{"method", method},
+                   {"adaptive", adaptive},
                    {"family", family},
                    {"order", order},
                    {"problem", problem},
@@ -124,7 +125,6 @@ RunReport run_nbody_case(const RunRequest& req, const MethodDef& def) {
   out.ecc = req.problem == "twobody" ? req.ecc : RunReport::nan;
   out.steps = r.steps;
   out.force_evals = r.force_evals;
-  out.adaptive = def.info.adaptive;
   out.rejected = r.rejected;
   out.precise_products = r.precise_products;
   out.h = r.h;
@@ -170,6 +170,7 @@ void label_report(RunReport& r, const RunRequest& req, const MethodDef& def) {
   r.order = def.info.order;
   r.problem = req.problem;
   r.precision = req.precision;
+  r.adaptive = def.info.adaptive;  // GBS too: its h is then the mean accepted step
   if (req.problem == "kepler" || req.problem == "harmonic" || req.problem == "twobody" || req.problem == "nbody")
     r.force = req.force;
 }

@@ -89,7 +89,6 @@ OrbitRun<T, N> run_orbit_with(const RunRequest& req, const MethodDef& def,
   label_report(r, req, def);
   r.steps = sol.accepted;
   r.force_evals = sol.force_evals;
-  r.adaptive = adaptive;
   r.rejected = sol.rejected;
   r.precise_products = sol.precise_products;
   r.seconds = std::chrono::duration<double>(w1 - w0).count();

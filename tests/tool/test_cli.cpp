@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -65,6 +66,48 @@ TEST(Cli, MethodsJsonListsTheCatalog) {
   EXPECT_EQ(j.back()["name"], "GBS");
   EXPECT_EQ(j.back()["order"], 24);  // 12 columns
   EXPECT_TRUE(j.back()["adaptive"].get<bool>());
+}
+
+TEST(Cli, MethodsDescribesTheSpecificationsNamed) {
+  // the records of any specifications `run --method` accepts, in the catalog's format, in the order given
+  const auto r = run("methods M12-adaptive mpe:1,2,3 GBS:bulirsch:10 DP12 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.size(), 4u);
+  EXPECT_EQ(j[0]["name"], "M12-adaptive");
+  EXPECT_EQ(j[0]["family"], "mpe");
+  EXPECT_EQ(j[0]["order"], 12);
+  // the products k = 1..6 on position Verlet: 1 + 2 + ... + 6 forces per step (Chin 2010, eq 17)
+  EXPECT_EQ(j[0]["force_evals_per_step"], 21);
+  EXPECT_TRUE(j[0]["adaptive"].get<bool>());
+  // the controller's exponent of an order-p expansion whose estimate has order p - 2: (p - 1) / (p + 1)
+  EXPECT_NEAR(j[0]["tolerance_exponent"].get<double>(), 11.0 / 13.0, 1e-15);
+  EXPECT_EQ(j[1]["order"], 6);
+  EXPECT_EQ(j[1]["force_evals_per_step"], 6);
+  EXPECT_FALSE(j[1]["adaptive"].get<bool>());
+  EXPECT_TRUE(j[1]["tolerance_exponent"].is_null());
+  EXPECT_EQ(j[2]["order"], 20);  // 10 columns
+  // a catalog method's record is the catalog's own
+  const auto cat = nlohmann::json::parse(run("methods --json").out);
+  for (const auto& m : cat)
+    if (m["name"] == "DP12") EXPECT_EQ(j[3], m);
+  // the table's columns stay aligned with names longer than the catalog's
+  const auto t = run("methods M12-adaptive DOP853-adaptive");
+  ASSERT_EQ(t.code, 0) << t.err;
+  std::istringstream lines(t.out);
+  std::string header, row1, row2;
+  std::getline(lines, header);
+  std::getline(lines, row1);
+  std::getline(lines, row2);
+  EXPECT_EQ(row1.find(" mpe "), header.find(" family"));
+  EXPECT_EQ(row2.find(" rkn "), header.find(" family"));
+  EXPECT_FALSE(std::getline(lines, header)) << "only the methods named are listed";
+  // refusals: one line, exit 2
+  for (const char* bad : {"methods NoSuchMethod", "methods M7", "methods GBS:fibonacci", "methods M8 --markdown"}) {
+    const auto b = run(bad);
+    EXPECT_EQ(b.code, 2) << bad;
+    EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << bad << ": " << b.err;
+  }
 }
 
 TEST(Cli, CoeffsMpeAreExactFractions) {
