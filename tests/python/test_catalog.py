@@ -1,4 +1,7 @@
 """nystrom.methods(), method_info() and coeffs(): the catalog seen from Python."""
+import json
+import os
+import subprocess
 from fractions import Fraction
 
 import pytest
@@ -112,3 +115,24 @@ def test_bch_orders_and_leading_terms():
         nystrom.bch("DP12")
     with pytest.raises(ValueError):
         nystrom.bch("VV", degree=0)
+
+
+def test_method_info_is_the_command_lines_record():
+    # `nystrom methods SPEC --json` and method_info(SPEC) describe the same method with the same numbers
+    tool = os.environ.get("NYSTROM_BIN")
+    if not tool:
+        pytest.skip("NYSTROM_BIN (the command-line tool) not set")
+    specs = ["M12-adaptive", "mpe:1,2,3", "GBS:bulirsch:10", "DP12-adaptive", "adjoint:Y4"]
+    out = subprocess.run([tool, "methods", *specs, "--json"], capture_output=True, text=True, check=True).stdout
+    records = json.loads(out)
+    assert [r["name"] for r in records] == [nystrom.method_info(s)["name"] for s in specs]
+    renamed = {"forces_per_step": "force_evals_per_step", "velocity": "velocity_dependent"}
+    for spec, cli in zip(specs, records):
+        py = nystrom.method_info(spec)
+        assert {renamed.get(k, k): v for k, v in py.items()} == cli, spec
+    # the same refusal, in the same words
+    bad = subprocess.run([tool, "methods", "GBS:fibonacci"], capture_output=True, text=True)
+    assert bad.returncode == 2
+    with pytest.raises(ValueError) as e:
+        nystrom.method_info("GBS:fibonacci")
+    assert str(e.value) in bad.stderr
