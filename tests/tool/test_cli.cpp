@@ -89,8 +89,11 @@ TEST(Cli, MethodsDescribesTheSpecificationsNamed) {
   EXPECT_EQ(j[2]["order"], 20);  // 10 columns
   // a catalog method's record is the catalog's own
   const auto cat = nlohmann::json::parse(run("methods --json").out);
-  for (const auto& m : cat)
-    if (m["name"] == "DP12") EXPECT_EQ(j[3], m);
+  for (const auto& m : cat) {
+    if (m["name"] == "DP12") {
+      EXPECT_EQ(j[3], m);
+    }
+  }
   // the table's columns stay aligned with names longer than the catalog's
   const auto t = run("methods M12-adaptive DOP853-adaptive");
   ASSERT_EQ(t.code, 0) << t.err;
