@@ -158,18 +158,18 @@ nystrom::cli::Registrar reg(
       auto* json_flag = app.add_flag("--json", *json, "Print one JSON array");
       app.add_flag("--markdown", *markdown, "Print the catalog page docs/methods.md")->excludes(json_flag);
       return [json, markdown, specs]() {
-        if (*markdown && !specs->empty())
-          throw nystrom::invalid_input("methods: --markdown prints the whole catalog, not named methods");
+        if (*markdown) {
+          if (!specs->empty())
+            throw nystrom::invalid_input("methods: --markdown prints the whole catalog, not named methods");
+          std::cout << markdown_page(nystrom::listed_methods());
+          return 0;
+        }
         std::vector<nystrom::MethodInfo> infos;
         if (specs->empty()) {
           for (const auto& d : nystrom::listed_methods()) infos.push_back(d.info);
         } else {
           // the record of the method a run with this specification executes (solve()'s resolution)
           for (const auto& spec : *specs) infos.push_back(nystrom::resolve_solve_method(spec).info);
-        }
-        if (*markdown) {
-          std::cout << markdown_page(nystrom::listed_methods());
-          return 0;
         }
         if (*json) {
           nlohmann::json arr = nlohmann::json::array();
