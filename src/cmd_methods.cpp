@@ -24,12 +24,14 @@ nlohmann::json info_json(const nystrom::MethodInfo& m) {
           {"order", m.order},
           {"stages", m.stages},
           {"force_evals_per_step", m.forces_per_step},
+          {"forces_per_step", m.forces_per_step},  // Python's name of the same number
           {"fsal", m.fsal},
           {"symmetric", m.symmetric},
           {"symplectic", m.symplectic},
           {"complex", m.complex},
           {"adaptive", m.adaptive},
           {"velocity_dependent", m.velocity},
+          {"velocity", m.velocity},  // Python's name of the same flag
           {"published_digits", m.published_digits},
           // the exponent and the anchor of the controller's tolerance (engines/step_control.hpp); null for
           // fixed steps

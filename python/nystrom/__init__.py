@@ -39,7 +39,9 @@ __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "solve_ivp", "Ode
 def methods():
     """The catalog: one dict per method with name, family, order, stages, forces_per_step, fsal,
     symmetric, symplectic, complex, adaptive, velocity (integrates velocity-dependent forces), published_digits,
-    aliases, source, description."""
+    tolerance_exponent, tolerance_anchor, aliases, source, description; force_evals_per_step and
+    velocity_dependent repeat forces_per_step and velocity under the names of ``nystrom methods --json``, so that
+    both records are the same."""
     return _core.methods()
 
 

@@ -61,12 +61,14 @@ py::dict info_dict(const MethodInfo& m) {
   d["order"] = m.order;
   d["stages"] = m.stages;
   d["forces_per_step"] = m.forces_per_step;
+  d["force_evals_per_step"] = m.forces_per_step;  // the command line's name of the same number
   d["fsal"] = m.fsal;
   d["symmetric"] = m.symmetric;
   d["symplectic"] = m.symplectic;
   d["complex"] = m.complex;
   d["adaptive"] = m.adaptive;
   d["velocity"] = m.velocity;
+  d["velocity_dependent"] = m.velocity;  // the command line's name of the same flag
   d["published_digits"] = m.published_digits;
   // the exponent and the anchor of the controller's tolerance (engines/step_control.hpp); None for fixed steps
   d["tolerance_exponent"] = m.adaptive ? py::object(py::float_(m.tolerance_exponent)) : py::none();

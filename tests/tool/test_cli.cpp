@@ -58,6 +58,9 @@ TEST(Cli, MethodsJsonListsTheCatalog) {
     EXPECT_GT(m["order"].get<int>(), 0);
     // GBS's cost per step varies with the order it chooses: listed as 0, and only there
     EXPECT_EQ(m["force_evals_per_step"].get<int>() > 0, m["family"] != "extrapolation") << m["name"];
+    // Python's names of the same number and flag (nystrom.methods() records carry both names too)
+    EXPECT_EQ(m["forces_per_step"], m["force_evals_per_step"]) << m["name"];
+    EXPECT_EQ(m["velocity"], m["velocity_dependent"]) << m["name"];
     EXPECT_FALSE(m["source"].get<std::string>().empty());
     names.insert(m["name"]);
   }
