@@ -7,6 +7,8 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <type_traits>
+#include <variant>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -14,32 +16,24 @@
 #include "cli.hpp"
 #include "nystrom/core/error.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/methods/method_record.hpp"
 #include "nystrom/planetary/wisdom_holman.hpp"
 
 namespace {
 
+// The library's record (methods/method_record.hpp) as a JSON object.
 nlohmann::json info_json(const nystrom::MethodInfo& m) {
-  return {{"name", m.name},
-          {"family", m.family},
-          {"order", m.order},
-          {"stages", m.stages},
-          {"force_evals_per_step", m.forces_per_step},
-          {"forces_per_step", m.forces_per_step},  // Python's name of the same number
-          {"fsal", m.fsal},
-          {"symmetric", m.symmetric},
-          {"symplectic", m.symplectic},
-          {"complex", m.complex},
-          {"adaptive", m.adaptive},
-          {"velocity_dependent", m.velocity},
-          {"velocity", m.velocity},  // Python's name of the same flag
-          {"published_digits", m.published_digits},
-          // the exponent and the anchor of the controller's tolerance (engines/step_control.hpp); null for
-          // fixed steps
-          {"tolerance_exponent", m.adaptive ? nlohmann::json(m.tolerance_exponent) : nlohmann::json(nullptr)},
-          {"tolerance_anchor", m.adaptive ? nlohmann::json(m.tolerance_anchor) : nlohmann::json(nullptr)},
-          {"aliases", m.aliases},
-          {"source", m.source},
-          {"description", m.description}};
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [key, value] : nystrom::method_record(m))
+    std::visit(
+        [&, &key = key](const auto& v) {
+          if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::monostate>)
+            out[key] = nullptr;
+          else
+            out[key] = v;
+        },
+        value);
+  return out;
 }
 
 // A table cell: '|' would end the cell.

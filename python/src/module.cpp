@@ -18,6 +18,8 @@
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -29,6 +31,7 @@
 #include "nystrom/analysis/bch_report.hpp"
 #include "nystrom/analysis/method_file.hpp"
 #include "nystrom/methods/catalog.hpp"
+#include "nystrom/methods/method_record.hpp"
 #include "nystrom/methods/mpe_coefficients.hpp"
 #include "nystrom/problems/plummer.hpp"
 #include "solve_binding.hpp"
@@ -54,28 +57,18 @@ auto released(F&& f) {
   return f();
 }
 
+// The library's record (methods/method_record.hpp) as a dict, null as None.
 py::dict info_dict(const MethodInfo& m) {
   py::dict d;
-  d["name"] = m.name;
-  d["family"] = m.family;
-  d["order"] = m.order;
-  d["stages"] = m.stages;
-  d["forces_per_step"] = m.forces_per_step;
-  d["force_evals_per_step"] = m.forces_per_step;  // the command line's name of the same number
-  d["fsal"] = m.fsal;
-  d["symmetric"] = m.symmetric;
-  d["symplectic"] = m.symplectic;
-  d["complex"] = m.complex;
-  d["adaptive"] = m.adaptive;
-  d["velocity"] = m.velocity;
-  d["velocity_dependent"] = m.velocity;  // the command line's name of the same flag
-  d["published_digits"] = m.published_digits;
-  // the exponent and the anchor of the controller's tolerance (engines/step_control.hpp); None for fixed steps
-  d["tolerance_exponent"] = m.adaptive ? py::object(py::float_(m.tolerance_exponent)) : py::none();
-  d["tolerance_anchor"] = m.adaptive ? py::object(py::float_(m.tolerance_anchor)) : py::none();
-  d["aliases"] = m.aliases;
-  d["source"] = m.source;
-  d["description"] = m.description;
+  for (const auto& [key, value] : method_record(m))
+    d[py::str(key)] = std::visit(
+        [](const auto& v) -> py::object {
+          if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::monostate>)
+            return py::none();
+          else
+            return py::cast(v);
+        },
+        value);
   return d;
 }
 
