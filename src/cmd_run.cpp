@@ -114,8 +114,9 @@ nystrom::cli::Registrar reg("run", "Integrate one problem with one method and re
   app.add_flag("--keep-complex", o->req.keep_complex, "Complex methods: keep the complex state between steps");
   app.add_option("--force", o->req.force,
                  "kepler, twobody, nbody: plain, or compensated (the force with its rounding error, double-word; "
-                 "used in double by the fixed-step splitting, composition and multi-product methods and by the "
-                 "adaptive RKN pairs, whose tolerance may then go down to eps/2)")
+                 "used in double by the fixed-step splitting, composition and multi-product methods, by the "
+                 "adaptive RKN pairs and by the adaptive multi-product expansions of one order, whose tolerance may "
+                 "then go down to eps/2)")
       ->capture_default_str();
   app.add_option("--output-times", o->sreq.output_times,
                  "Kepler: A:B:N, the state at N equally spaced times from A to B (listed after the table; JSON "

@@ -71,9 +71,10 @@ class Kepler(Problem):
     v0 = (0, sqrt((1-e)/(1+e))), energy -1/2, period 2 pi, started at apocentre.
 
     compensated=True: the force in double-word arithmetic (CompensatedKeplerForce), which the fixed-step splitting,
-    composition and multi-product methods (SS10, KL8, M8, ...) and the adaptive RKN pairs (DP12-adaptive,
-    DOP853-adaptive, tolerances then down to eps/2) in double use to go below the plain force's rounding; other
-    methods and precisions are refused, as by `nystrom run --force compensated`."""
+    composition and multi-product methods (SS10, KL8, M8, ...), the adaptive RKN pairs (DP12-adaptive,
+    DOP853-adaptive) and the adaptive multi-product expansions of one order (M12-adaptive, ...; tolerances then
+    down to eps/2) in double use to go below the plain force's rounding; other methods and precisions are refused,
+    as by `nystrom run --force compensated`."""
 
     def __init__(self, e=0.9, compensated=False):
         e = _real("e", e)
@@ -171,8 +172,9 @@ class NBody(Problem):
     State arrays have shape (N, 3). ``eps`` is the softening length.
 
     compensated=True: the force in double-word arithmetic (CompensatedNBodyForce), which the fixed-step splitting,
-    composition and multi-product methods and the adaptive RKN pairs in double use to go below the plain force's
-    rounding; other methods and precisions are refused, as by `nystrom run --force compensated`.
+    composition and multi-product methods, the adaptive RKN pairs and the adaptive multi-product expansions of one
+    order in double use to go below the plain force's rounding; other methods and precisions are refused, as by
+    `nystrom run --force compensated`.
     """
 
     def __init__(self, masses=None, G=1.0, eps=0.0, compensated=False):

@@ -617,6 +617,36 @@ def test_kepler_compensated_force_goes_below_the_plain_floor():
     assert np.linalg.norm(back.v[-1] * [-1, 1] - vx) < 1.5e-13
 
 
+def test_kepler_compensated_force_takes_the_adaptive_mpe_below_the_plain_floor():
+    # M12-adaptive over 100 periods at e = 0.5: with Kepler(e, compensated=True) its products run in double-word, the
+    # tolerance may go down to eps/2 (the plain force is refused there, with the hint), and the runs end within a few
+    # 1e-14 of the orbit (double-double reference; measured 1.7e-14 and 8.8e-15), where the plain force's products
+    # leave a few 1e-12 at its tightest tolerances. Backward in time a run ends at the mirror image of the orbit's end.
+    from decimal import Decimal
+
+    t1 = 200 * math.pi
+    plain, comp = Kepler(0.5), Kepler(0.5, compensated=True)
+    with pytest.raises(ValueError, match="eps / 2 with a compensated force"):
+        nystrom.solve(plain, t_span=(0, t1), method="M12-adaptive", rtol=2e-16)
+    ref = nystrom.solve(plain, t_span=(0, t1), method="DP12-adaptive", rtol=1e-26, precision="dd", t_eval=[t1])
+    qx = np.array([float(Decimal(x)) for x in ref.q_str])
+    vx = np.array([float(Decimal(x)) for x in ref.v_str])
+
+    def errors(prob, tols):
+        runs = [nystrom.solve(prob, t_span=(0, t1), method="M12-adaptive", rtol=tol) for tol in tols]
+        assert all(r.success for r in runs)
+        return (np.array([np.linalg.norm(r.q[-1] - qx) for r in runs]),
+                np.array([np.linalg.norm(r.v[-1] - vx) for r in runs]))
+
+    ep, _ = errors(plain, [3e-15, 5e-15])
+    ec, evc = errors(comp, [1.8e-16, 3.2e-16])
+    assert ec.max() < 0.1 * ep.max(), (ec, ep)
+    assert ec.max() < 5e-14 and evc.max() < 5e-14, (ec, evc)
+    back = nystrom.solve(comp, t_span=(0, -t1), method="M12-adaptive", rtol=3.2e-16)
+    assert np.linalg.norm(back.q[-1] * [1, -1] - qx) < 5e-14
+    assert np.linalg.norm(back.v[-1] * [-1, 1] - vx) < 5e-14
+
+
 def test_kepler_compensated_force_takes_fixed_step_splitting_to_the_rounding():
     # SS10 over t = 640 (about 102 periods) at e = 0.5 with fixed steps whose truncation lies below the rounding of the
     # result (steps of 2^-8 and 5 2^-10, exact, so that the run ends at 640 exactly): with Kepler(e,
@@ -680,7 +710,7 @@ def test_kepler_compensated_force_refusals():
     with pytest.raises(ValueError, match="is used by the adaptive RKN pairs"):
         nystrom.solve(comp, t_span=(0, 1), method="DP12", steps=10)
     with pytest.raises(ValueError, match="is used by the adaptive RKN pairs"):
-        nystrom.solve(comp, t_span=(0, 1), method="M12-adaptive", rtol=1e-12)
+        nystrom.solve(comp, t_span=(0, 1), method="MPE-adaptive", rtol=1e-12)
     with pytest.raises(ValueError, match="runs in double precision"):
         nystrom.solve(comp, t_span=(0, 1), method="DP12-adaptive", rtol=1e-20, precision="dd")
     with pytest.raises(TypeError, match="compensated must be True or False"):

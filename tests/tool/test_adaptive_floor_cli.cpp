@@ -265,12 +265,46 @@ TEST(AdaptiveFloorCli, Dp12AdaptiveWithTheCompensatedForce) {
   }
 }
 
+// With the compensated Kepler force the adaptive multi-product expansion runs its products' drifts and kicks in
+// double-word (trial_carried, engines/adaptive_mpe_kernels.hpp) and accepts tolerances down to eps/2: the error keeps
+// falling with the tolerance below the plain force's floor, and at the four tightest tolerances it stays at most
+// 1.5e-13 / 1.6e-12 (M12-adaptive, e = 0.5 / 0.9; measured 6.5e-14 and 8.1e-13) and 1e-13 / 2e-12 (M16-adaptive;
+// measured 4.5e-14 and 1.1e-12), a fifth of the plain force's floor or less; every step, accepted or rejected,
+// costs the method's forces.
+TEST(AdaptiveFloorCli, AdaptiveMpeWithTheCompensatedForce) {
+  for (const std::string method : {"M12-adaptive", "M16-adaptive"}) {
+    const AdaptiveInfo info = adaptive_info(method);
+    for (double ecc : {0.5, 0.9}) {
+      SCOPED_TRACE(method + " e " + tol_text(ecc));
+      const auto plain = sweep(method, ecc, 52);
+      const auto comp = sweep(method, ecc, 52, " --force compensated");
+      ASSERT_GE(plain.size(), 4u);
+      ASSERT_GE(comp.size(), 12u);
+      EXPECT_LE(comp.back().tol, 2e-16) << "tolerances down to eps/2 are accepted";
+      double worst_plain = 0, worst = 0;
+      for (std::size_t i = plain.size() - 4; i < plain.size(); ++i) worst_plain = std::max(worst_plain, plain[i].error);
+      for (std::size_t i = comp.size() - 4; i < comp.size(); ++i) worst = std::max(worst, comp[i].error);
+      for (const auto& p : comp)
+        EXPECT_EQ(p.force_evals, info.per_step * (p.steps + p.rejected) + 2) << "tol " << p.tol;
+      // Below the plain force's tightest tolerance the error still falls: over the last two decades, 10x at least.
+      EXPECT_LT(comp.back().error, 0.1 * comp[comp.size() - 9].error);
+      std::printf(
+          "[ floor ] %s --force compensated e %.1f: largest error at the four tightest tolerances %.3e (plain "
+          "force %.3e)\n",
+          method.c_str(), ecc, worst, worst_plain);
+      const bool m12 = method == "M12-adaptive";
+      EXPECT_LE(worst, ecc < 0.7 ? (m12 ? 1.5e-13 : 1e-13) : (m12 ? 1.6e-12 : 2e-12));
+      EXPECT_LT(worst, 0.2 * worst_plain);
+    }
+  }
+}
+
 // The compensated force is refused where nothing would use it, with a one-line usage error.
 TEST(AdaptiveFloorCli, CompensatedForceIsRefusedWhereNothingUsesIt) {
   for (const std::string args :
        {"--method DP12 --steps-per-period 100", "--method DP12-adaptive --tol 1e-12 --precision long-double",
         "--problem harmonic --method DP12-adaptive --tol 1e-12", "--method DP12-adaptive --tol 1e-12 --force exact",
-        "--method M12-adaptive --tol 1e-12", "--problem outer-solar-system --method SS10",
+        "--method MPE-adaptive --tol 1e-12", "--problem outer-solar-system --method SS10",
         "--problem arenstorf --method GBS --tol 1e-10", "--problem nbody --n 8 --method DP12 --steps 10"}) {
     const std::string force = args.find("--force") == std::string::npos ? " --force compensated" : "";
     const auto r = run("run " + args + force + " --json");

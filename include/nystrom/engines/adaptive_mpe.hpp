@@ -111,7 +111,13 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
     for (std::size_t i = 0; i < k_.size(); ++i)
       if (!is_finite_scalar(c_[i]) || !is_finite_scalar(d_[i]))
         throw std::invalid_argument("adaptive MPE: coefficient is not finite");
-    adaptive_detail::check_tolerance<real_type>(opt_);
+    compensated_ = use_compensation<scalar_type>(eopt_.compensated);
+    carried_ = Kernels::carried_force && compensated_;
+    // With a compensated force the tolerance may go down to eps / 2, as for the adaptive RKN pairs (the refusal
+    // says so where such a force would be taken: one order per run, double or float, compensated).
+    const bool could = (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>)&&compensated_ &&
+                       !carried_ && orders.c.empty();
+    adaptive_detail::check_tolerance<real_type>(opt_, carried_, could);
     if (eopt_.mpe_schedule == MpeSchedule::concurrent)
       throw std::invalid_argument(
           "adaptive MPE: the concurrent schedule is not available (use lockstep or sequential)");
@@ -123,12 +129,19 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
     // 4512 and 5e-11).
     double dsum = 0;
     for (const auto& di : d_) dsum += std::abs(as_double(di));
+    // With a compensated force (trial_carried) the products are double-words and the estimate's round-off is about
+    // eps times smaller.
     noise_floor_ = real_type(10 * dsum * as_double(epsilon_of<real_type>()));
+    if (carried_) noise_floor_ = real_type(noise_floor_ * epsilon_of<real_type>());
     method_order_ = 2 * static_cast<int>(k_.size());
     if (opt_.error_order == 0) opt_.error_order = method_order_ - 2;
     this->setup(eopt_.mpe_schedule);
-    compensated_ = use_compensation<scalar_type>(eopt_.compensated);
-    if (!orders.c.empty()) setup_order_control(std::move(orders));
+    if (!orders.c.empty()) {
+      if (carried_)
+        throw std::invalid_argument(
+            "adaptive MPE: order control calls force(q, a); run it with a plain force (or one order per run)");
+      setup_order_control(std::move(orders));
+    }
   }
 
   const AdaptiveOptions& options() const { return opt_; }
@@ -136,6 +149,9 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   int method_order() const { return method_order_; }
   bool lockstep() const { return lockstep_; }
   bool compensated() const { return compensated_; }
+  /// Whether the products take the force's rounding: a compensated run in double or float with a compensated force,
+  /// force(q, cq, a, alo) (trial_carried, engines/adaptive_mpe_kernels.hpp), at every tolerance.
+  bool carried() const { return carried_; }
   /// Whether the products carry their own rounding (precise products, engines/adaptive_mpe_kernels.hpp): a
   /// compensated run of a built-in floating type on a symmetric base whose controlled tolerance (tol, or atol when
   /// tol is 0, through the method's calibration) is at most kPreciseProducts eps, where the increments' rounding,
@@ -370,28 +386,36 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
         store();
         adaptive_detail::throw_underflow("adaptive MPE", as_double(t), as_double(h), error_finite);
       }
-      if (!(local && verlet)) scale(h);
-      if (kick_first_ && !a0_valid) {
+      bool carried = false;  // the products with a compensated force (trial_carried)
+      if constexpr (Comp && Kernels::carried_force) {
+        if (carried_) {
+          a0_evals += this->trial_carried(s, ccq, ccv, h, inc, err, low);
+          carried = true;
+        }
+      }
+      if (!carried && !(local && verlet)) scale(h);
+      if (!carried && kick_first_ && !a0_valid) {
         base_.force()(s.q, a0);
         ++a0_evals;
         a0_valid = true;
       }
-      Kernels::template with_precision<Comp>(precise, [&](auto pr) NYSTROM_ALWAYS_INLINE {
-        constexpr bool P = decltype(pr)::value;
-        if constexpr (local) {
-          if (verlet)
-            own_evals_ += this->template trial_verlet<K, P>(s, a0, h, inc, err, low);
-          else
-            this->template trial<Comp, P>(std::integral_constant<std::size_t, K>{}, s, a0, lx, la, lcq, lcv, inc, err,
-                                          low);
-        } else {
-          this->template trial<Comp, P>(k_.size(), s, a0, xs_, as_, cqs_, cvs_, inc, err, low);
-        }
-      });
+      if (!carried)
+        Kernels::template with_precision<Comp>(precise, [&](auto pr) NYSTROM_ALWAYS_INLINE {
+          constexpr bool P = decltype(pr)::value;
+          if constexpr (local) {
+            if (verlet)
+              own_evals_ += this->template trial_verlet<K, P>(s, a0, h, inc, err, low);
+            else
+              this->template trial<Comp, P>(std::integral_constant<std::size_t, K>{}, s, a0, lx, la, lcq, lcv, inc, err,
+                                            low);
+          } else {
+            this->template trial<Comp, P>(k_.size(), s, a0, xs_, as_, cqs_, cvs_, inc, err, low);
+          }
+        });
       const double e2 = adaptive_detail::error_norm2(s, inc, err, err_scale, noise_floor_);
       error_finite = e2 < std::numeric_limits<double>::infinity();
       if (e2 <= 1.0) {
-        apply_increment<Comp>(s, ccq, ccv, inc, low, precise);
+        apply_increment<Comp>(s, ccq, ccv, inc, low, precise || carried);
         a0_valid = false;
         t = last ? t1 : t + h;
         ++accepted;
@@ -615,6 +639,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   EngineOptions eopt_;
   bool compensated_ = false;
   int method_order_ = 0;
+  bool carried_ = false;     // the products take the force's rounding (carried())
   real_type noise_floor_{};  // the error scale's floor, relative to the increment (see the constructor)
   long extra_evals_ = 0;     // forces outside the base's count: starting steps, forces at q_0
   real_type h_next_ = real_type(0);

@@ -629,6 +629,54 @@ class MpeKernels {
     }
   }
 
+  // The products with a compensated force, force(q, cq, a, alo) (SplittingStepper::carried_force), as the
+  // fixed-step engine's carried steps (engines/mpe.hpp): each product starts from s with the run's carries ccq, ccv
+  // and runs the base's double-word drifts and kicks (SplittingStepper::carried_product; the base's coefficients
+  // times h / k_i as double-words, the force at q + cq with its low part), its increment a double-word. Then
+  // inc + low = T_2n - s (the reference increment and, as its low part, the combination of the products'
+  // differences) and err = T_2n - T_{2n-2}. The products' forces count in the base; returns the forces at s
+  // (kick-first bases), which the caller counts.
+  static constexpr bool carried_force = SplittingStepper<V, Force>::carried_force;
+  long trial_carried(const State<V>& s, const V& ccq, const V& ccv, const real_type& h, State<V>& inc, State<V>& err,
+                     State<V>& low) requires carried_force {
+    using S = scalar_type;
+    const std::size_t P = k_.size(), n = s.q.size();
+    base_.scale_products_carried(S(h), k_, carried_);
+    cx_.resize(P);
+    clo_.resize(P);
+    V a0{}, a0lo{}, a{}, alo{};
+    resize_like(a0, s.q);
+    resize_like(a0lo, s.q);
+    long at_s = 0;
+    if (kick_first_) {
+      base_.force()(s.q, ccq, a0, a0lo);
+      ++at_s;
+    }
+    for (std::size_t i = 0; i < P; ++i)
+      base_.carried_product(s, ccq, ccv, a0, a0lo, carried_.data() + i * m_, k_[i], cx_[i], clo_[i], a, alo);
+    const State<V>& xr = cx_[ref_];
+    const State<V>& lr = clo_[ref_];
+    for (std::size_t j = 0; j < n; ++j) {
+      S dq = 0, dv = 0, eq = 0, ev = 0;
+      for (std::size_t i = 0; i < P; ++i) {
+        if (i == ref_) continue;
+        const S xq = (cx_[i].q[j] - xr.q[j]) + (clo_[i].q[j] - lr.q[j]);
+        const S xv = (cx_[i].v[j] - xr.v[j]) + (clo_[i].v[j] - lr.v[j]);
+        dq += c_[i] * xq;
+        dv += c_[i] * xv;
+        eq += d_[i] * xq;
+        ev += d_[i] * xv;
+      }
+      inc.q[j] = xr.q[j];
+      inc.v[j] = xr.v[j];
+      low.q[j] = lr.q[j] + dq;
+      low.v[j] = lr.v[j] + dv;
+      err.q[j] = eq;
+      err.v[j] = ev;
+    }
+    return at_s;
+  }
+
   std::vector<long> k_;
   std::vector<scalar_type> c_, d_;
   SplittingStepper<V, Force> base_;
@@ -643,6 +691,9 @@ class MpeKernels {
   std::vector<std::size_t> by_k_;              // product indices by decreasing k (trial_verlet's issue order)
   std::vector<std::vector<scalar_type>> occ_;  // order control: the coefficients of T_2n over k = 1..n
   std::vector<std::vector<scalar_type>> ocd_;  // order control: T_2n - T_{2n-2} over k = 1..n
+  // trial_carried: the double-word coefficients of the products, their states and their carries
+  std::vector<typename SplittingStepper<V, Force>::Scaled> carried_;
+  std::vector<State<V>> cx_, clo_;
 };
 
 }  // namespace adaptive_detail

@@ -172,14 +172,7 @@ class MpeStepper {
     using S = scalar_type;
     const std::size_t P = k_.size(), m = base_.scheme().steps.size();
     if (!carried_for_h_ || !(carried_h_ == h)) {
-      carried_.clear();
-      for (std::size_t i = 0; i < P; ++i) {
-        // h / k_i as a double-word: the rounded quotient and the exact remainder over k_i
-        const S k = static_cast<S>(k_[i]), hk = S(h) / k;
-        S e;
-        const S p = eft::two_prod(hk, k, e);
-        base_.scale_coefficients_carried(hk, S(((S(h) - p) - e) / k), carried_);
-      }
+      base_.scale_products_carried(S(h), k_, carried_);
       carried_h_ = h;
       carried_for_h_ = true;
     }
@@ -193,25 +186,10 @@ class MpeStepper {
         base_.force()(s.q, comp_.cq, a0, a0lo);
         ++extra_evals_;
       }
-      for (std::size_t i = 0; i < P; ++i) {
-        State<V>& x = products_[i];
-        State<V>& lo = lows_[i];  // the product's carries, then its increment's low part
-        x = s;
-        lo.q = comp_.cq;
-        lo.v = comp_.cv;
-        a = a0;
-        alo = a0lo;
-        bool valid = starts_with_kick_;
-        base_.advance_carried(x, a, alo, valid, carried_.data() + i * m, k_[i], lo.q, lo.v);
-        // The increment as a double-word: (x - s) + (carry_i - carry), its high part from an exact two-sum.
-        for (std::size_t j = 0; j < s.q.size(); ++j) {
-          S e;
-          x.q[j] = eft::two_sum(x.q[j], S(-s.q[j]), e);
-          lo.q[j] = e + (lo.q[j] - comp_.cq[j]);
-          x.v[j] = eft::two_sum(x.v[j], S(-s.v[j]), e);
-          lo.v[j] = e + (lo.v[j] - comp_.cv[j]);
-        }
-      }
+      // Each product's increment as a double-word: products_[i] + lows_[i].
+      for (std::size_t i = 0; i < P; ++i)
+        base_.carried_product(s, comp_.cq, comp_.cv, a0, a0lo, carried_.data() + i * m, k_[i], products_[i], lows_[i],
+                              a, alo);
       // T_ref + sum_{i != ref} c_i (T_i - T_ref): the differences of the increments (of the order of the base's
       // local error) rounded once, the reference increment added as a double-word by an exact two-sum.
       const State<V>& tref = products_[ref_];

@@ -348,6 +348,41 @@ class SplittingStepper {
       out.push_back(scaled(st[i].coef, lo_.empty() ? scalar_type(0) : lo_[i], h, h_lo));
   }
 
+  /// The coefficients of the products of a multi-product expansion, product i running k[i] steps of h / k[i] (the
+  /// rounded quotient and the exact remainder over k[i], a double-word), product after product (m sub-steps each;
+  /// out is replaced).
+  void scale_products_carried(const scalar_type& h, const std::vector<long>& k, std::vector<Scaled>& out) const {
+    out.clear();
+    for (long ki : k) {
+      const scalar_type kk = static_cast<scalar_type>(ki), hk = h / kk;
+      scalar_type e;
+      const scalar_type p = eft::two_prod(hk, kk, e);
+      scale_coefficients_carried(hk, scalar_type(((h - p) - e) / kk), out);
+    }
+  }
+
+  /// One product of a multi-product expansion with a compensated force: n steps with the coefficients hcw
+  /// (scale_products_carried) from s with the run's carries cq, cv (and the force there, a0 + a0lo, when the scheme
+  /// starts with a kick), through advance_carried; then x + lo is the product's increment (T - s) + (carry_T - cq),
+  /// the high part x from an exact two-sum. a, alo: the force cache's buffers. The force evaluations are counted.
+  void carried_product(const State<V>& s, const V& cq, const V& cv, const V& a0, const V& a0lo, const Scaled* hcw,
+                       long n, State<V>& x, State<V>& lo, V& a, V& alo) requires carried_force {
+    x = s;
+    lo.q = cq;
+    lo.v = cv;
+    a = a0;
+    alo = a0lo;
+    bool valid = scheme_.steps.front().flow == Flow::kick;
+    advance_carried(x, a, alo, valid, hcw, n, lo.q, lo.v);
+    for (std::size_t j = 0; j < s.q.size(); ++j) {
+      scalar_type e;
+      x.q[j] = eft::two_sum(x.q[j], scalar_type(-s.q[j]), e);
+      lo.q[j] = e + (lo.q[j] - cq[j]);
+      x.v[j] = eft::two_sum(x.v[j], scalar_type(-s.v[j]), e);
+      lo.v[j] = e + (lo.v[j] - cv[j]);
+    }
+  }
+
   /// The compensated run with a compensated force (carried_force) on a state x, force cache a + alo (valid: it is
   /// the force at x.q + cq; updated) and carries cq, cv held by the caller: n steps with the scaled coefficients
   /// hcw (scale_coefficients_carried, m sub-steps). The position q + cq goes to the force, which returns a + alo; a
