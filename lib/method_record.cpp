@@ -17,6 +17,7 @@ MethodRecord method_record(const MethodInfo& m) {
           {"symplectic", m.symplectic},
           {"complex", m.complex},
           {"adaptive", m.adaptive},
+          {"order_control", m.order_control},
           {"velocity_dependent", m.velocity},
           {"velocity", m.velocity},
           {"published_digits", m.published_digits},

@@ -38,7 +38,8 @@ __all__ = ["methods", "method_info", "coeffs", "bch", "solve", "solve_ivp", "Ode
 
 def methods():
     """The catalog: one dict per method with name, family, order, stages, forces_per_step, fsal,
-    symmetric, symplectic, complex, adaptive, velocity (integrates velocity-dependent forces), published_digits,
+    symmetric, symplectic, complex, adaptive, order_control (an adaptive multi-product expansion choosing its order
+    per step), velocity (integrates velocity-dependent forces), published_digits,
     tolerance_exponent, tolerance_anchor, aliases, source, description; force_evals_per_step and
     velocity_dependent repeat forces_per_step and velocity under the names of ``nystrom methods --json``, so that
     both records are the same."""

@@ -13,7 +13,7 @@ def test_methods_lists_families_with_their_fields():
     cat = nystrom.methods()
     assert len(cat) >= 20
     keys = {"name", "family", "order", "stages", "forces_per_step", "fsal", "symmetric", "symplectic", "complex",
-            "adaptive", "published_digits", "tolerance_exponent", "aliases", "source", "description"}
+            "adaptive", "order_control", "published_digits", "tolerance_exponent", "aliases", "source", "description"}
     for m in cat:
         assert keys <= set(m)
         # The controller's tolerance exponent: in (0.5, 1] for an adaptive method, None for fixed steps.
@@ -22,6 +22,9 @@ def test_methods_lists_families_with_their_fields():
         assert m["family"] in {"splitting", "composition", "rkn", "mpe", "extrapolation"}
         assert m["order"] >= 2
     names = {m["name"]: m for m in cat}
+    # Order control (the order chosen per step) is an adaptive multi-product expansion, the catalog's MPE-adaptive.
+    assert {n for n, m in names.items() if m["order_control"]} == {"MPE-adaptive"}
+    assert nystrom.method_info("MPE-adaptive-max:8")["order_control"] is True
     # Orders from the publications: Verlet 2, Forest-Ruth 4 (Chin 2010), DP12 12 (Dormand, El-Mikkawy, Prince).
     assert names["VV"]["order"] == 2 and names["PV"]["order"] == 2
     assert names["FR"]["order"] == 4 and names["FR"]["symplectic"]

@@ -85,6 +85,11 @@ TEST(Cli, MethodsDescribesTheSpecificationsNamed) {
   EXPECT_TRUE(j[0]["adaptive"].get<bool>());
   // the controller's exponent of an order-p expansion whose estimate has order p - 2: (p - 1) / (p + 1)
   EXPECT_NEAR(j[0]["tolerance_exponent"].get<double>(), 11.0 / 13.0, 1e-15);
+  // one order per run; order control (an adaptive MPE choosing its order per step) is flagged in the record
+  EXPECT_FALSE(j[0]["order_control"].get<bool>());
+  const auto oc = nlohmann::json::parse(run("methods MPE-adaptive-max:8 --json").out);
+  EXPECT_TRUE(oc.at(0)["order_control"].get<bool>());
+  EXPECT_TRUE(oc.at(0)["adaptive"].get<bool>());
   EXPECT_EQ(j[1]["order"], 6);
   EXPECT_EQ(j[1]["force_evals_per_step"], 6);
   EXPECT_FALSE(j[1]["adaptive"].get<bool>());

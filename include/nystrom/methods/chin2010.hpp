@@ -187,6 +187,7 @@ inline MethodDef mpe_order_control_method(int max_order, std::string name) {
   for (long i = 1; i <= max_order / 2; ++i) k.push_back(i);
   MethodDef d = mpe_method(k, "PV", std::move(name));
   d.info.adaptive = true;
+  d.info.order_control = true;
   d.info.source = "Chin (2010) eqs (14), (17); order control after Hairer, Norsett & Wanner, Solving ODEs I, sec. II.9";
   d.info.description = "multi-product expansion over PV, order 4.." + std::to_string(max_order) +
                        " and step chosen per step by work per unit step (estimates: the products without the "

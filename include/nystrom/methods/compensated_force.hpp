@@ -16,8 +16,8 @@ namespace nystrom {
 inline bool uses_compensated_force(const MethodInfo& m) {
   if (m.complex) return false;
   if (m.family == "rkn") return m.adaptive;
-  // the adaptive MPE with one order per run; order control (MPE-adaptive, MPE-adaptive-max:N) calls force(q, a)
-  if (m.family == "mpe") return !m.adaptive || m.name.rfind("MPE-adaptive", 0) != 0;
+  // the multi-product expansions but order control (MPE-adaptive, MPE-adaptive-max:N), which calls force(q, a)
+  if (m.family == "mpe") return !m.order_control;
   return m.family == "splitting" || m.family == "composition";
 }
 

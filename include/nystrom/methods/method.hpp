@@ -27,10 +27,11 @@ struct MethodInfo {
   bool symmetric = false;
   bool symplectic = false;
   bool complex = false;
-  bool adaptive = false;     // embedded pair with step-size control
-  bool velocity = false;     // integrates velocity-dependent forces a(t, q, v) (y'' = f(t, y, y'))
-  int published_digits = 0;  // 0: exact (rational or closed form); else digits of the published table
-  std::string source;        // the publication the coefficients come from
+  bool adaptive = false;       // embedded pair with step-size control
+  bool order_control = false;  // adaptive multi-product expansion choosing its order per step (MpeDef::order_control)
+  bool velocity = false;       // integrates velocity-dependent forces a(t, q, v) (y'' = f(t, y, y'))
+  int published_digits = 0;    // 0: exact (rational or closed form); else digits of the published table
+  std::string source;          // the publication the coefficients come from
   std::string description;
   std::vector<std::string> aliases;
   // Adaptive methods: the exponent gamma and the anchor of the controller's tolerance (engines/step_control.hpp,
