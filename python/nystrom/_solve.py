@@ -31,7 +31,8 @@ class OdeResult(AttrDict):
     Attributes: ``t`` (output times), ``q``, ``v`` (positions and velocities, shape ``(len(t),) +
     q0.shape``), ``force_evals`` (by the method), ``output_force_evals`` (for output times, events and the
     dense output), ``steps``, ``rejected``, ``precise_products`` (adaptive multi-product methods: whether the
-    products carried their own rounding, as at tight tolerances; False for every other method), ``status`` (0:
+    products carried their own rounding, as at tight tolerances or with a compensated force; False for every
+    other method), ``status`` (0:
     reached the end of t_span, 1: a terminal event, -1: failure: step size underflow, too many steps or a state
     no longer finite; ``t``, ``q``, ``v`` then hold the states saved before it), ``message``, ``success``,
     ``sol`` (a :class:`DenseSolution` when ``dense_output=True``), ``t_events``, ``q_events``, ``v_events`` (one

@@ -180,31 +180,42 @@ TEST(Compensated, ErrorFreeSumAndProductAreExact) {
 
 namespace {
 
-// rms over tolerances 10^log_tol0 .. 10^(log_tol0 - 0.75) of DP12-adaptive's final position error on Kepler (100
-// periods), against the exact orbit of the run's own initial state; plain control (the controller works to tol
-// itself: round-off against truncation at given tolerances, not the calibration of tolerance proportionality).
+// The rms final position and velocity errors of an adaptive method on Kepler over 100 periods at the seven tolerances
+// 10^(log_tol0 - k/8), k = 0..6, with the force F, against the exact orbit of the run's initial state; steps: the
+// accepted steps at the tightest. The RKN pairs run under plain control (the controller works to tol itself: round-off
+// against truncation at given tolerances, not the calibration of tolerance proportionality); the multi-product
+// expansions under their calibration.
 template <class T, class Force = KeplerForce>
-double adaptive_floor_rms(double ecc, long* steps = nullptr, double log_tol0 = -13.75) {
+ReferenceErrors floor_rms(const char* method, double ecc, double log_tol0, long* steps) {
   using VT = std::array<T, 2>;
   const KeplerProblem<T> kp(static_cast<T>(ecc));
-  const MethodDef def = resolve_method("DP12-adaptive");
+  const MethodDef def = resolve_method(method);
+  const bool mpe = def.info.family == "mpe";
   const T t_end = KeplerProblem<T>::period() * T(100);
-  double sum = 0;
-  int n = 0;
+  double sq = 0, sv = 0;
   for (int k = 0; k <= 6; ++k) {
     AdaptiveOptions opt;
     opt.rtol = std::pow(10.0, log_tol0 - k / 8.0);
-    opt.tolerance_exponent = 1;
-    auto ai = make_adaptive_integrator<VT>(def, Force{}, opt);
+    if (!mpe) opt.tolerance_exponent = 1;
     const State<VT> s0 = kp.initial_state();
     State<VT> s = s0;
-    const AdaptiveStats st = ai.integrate_to(s, T(0), t_end);
-    const double e = kepler_reference_errors(s0, s, t_end, 1).position;
-    sum += e * e;
-    ++n;
-    if (steps) *steps = st.accepted;
+    const AdaptiveStats st = mpe ? make_adaptive_mpe_integrator<VT>(def, Force{}, opt).integrate_to(s, T(0), t_end)
+                                 : make_adaptive_integrator<VT>(def, Force{}, opt).integrate_to(s, T(0), t_end);
+    const auto e = kepler_reference_errors(s0, s, t_end, 1);
+    sq += e.position * e.position;
+    sv += e.velocity * e.velocity;
+    *steps = st.accepted;
   }
-  return std::sqrt(sum / n);
+  ReferenceErrors out;
+  out.position = std::sqrt(sq / 7);
+  out.velocity = std::sqrt(sv / 7);
+  return out;
+}
+
+// DP12-adaptive's rms final position error (floor_rms).
+template <class T, class Force = KeplerForce>
+double adaptive_floor_rms(double ecc, long* steps, double log_tol0 = -13.75) {
+  return floor_rms<T, Force>("DP12-adaptive", ecc, log_tol0, steps).position;
 }
 
 }  // namespace
@@ -388,38 +399,6 @@ TEST(Compensated, PreciseProductsRunRestartsBitwiseBothDirections) {
   }
 }
 
-namespace {
-
-// The rms final position and velocity errors of M12-adaptive (or another adaptive MPE) on Kepler over 100 periods
-// at the seven tolerances 10^(log_tol0 - k/8), k = 0..6, with the force F, against the exact orbit of the run's
-// initial state; steps: the accepted steps at the tightest.
-template <class T, class Force>
-ReferenceErrors mpe_floor_rms(const char* method, double ecc, double log_tol0, long* steps) {
-  using VT = std::array<T, 2>;
-  const KeplerProblem<T> kp(static_cast<T>(ecc));
-  const MethodDef def = resolve_method(method);
-  const T t_end = KeplerProblem<T>::period() * T(100);
-  double sq = 0, sv = 0;
-  for (int k = 0; k <= 6; ++k) {
-    AdaptiveOptions opt;
-    opt.rtol = std::pow(10.0, log_tol0 - k / 8.0);
-    auto ai = make_adaptive_mpe_integrator<VT>(def, Force{}, opt);
-    const State<VT> s0 = kp.initial_state();
-    State<VT> s = s0;
-    const AdaptiveStats st = ai.integrate_to(s, T(0), t_end);
-    const auto e = kepler_reference_errors(s0, s, t_end, 1);
-    sq += e.position * e.position;
-    sv += e.velocity * e.velocity;
-    *steps = st.accepted;
-  }
-  ReferenceErrors out;
-  out.position = std::sqrt(sq / 7);
-  out.velocity = std::sqrt(sv / 7);
-  return out;
-}
-
-}  // namespace
-
 // With the compensated force the products of the adaptive multi-product expansion run the base's drifts and kicks
 // in double-word (trial_carried), their increments reach the run's carries as double-words, and the estimate's
 // round-off floor falls with them: at tolerances 10^-13.75 .. 10^-14.5 the rms final position and velocity errors
@@ -428,9 +407,9 @@ ReferenceErrors mpe_floor_rms(const char* method, double ecc, double log_tol0, l
 TEST(Compensated, CompensatedForceTakesAdaptiveMpeToItsTruncation) {
   for (double ecc : {0.5, 0.9}) {
     long steps_p = 0, steps_c = 0, steps_l = 0;
-    const auto plain = mpe_floor_rms<double, KeplerForce>("M12-adaptive", ecc, -13.75, &steps_p);
-    const auto comp = mpe_floor_rms<double, CompensatedKeplerForce>("M12-adaptive", ecc, -13.75, &steps_c);
-    const auto ld = mpe_floor_rms<long double, KeplerForce>("M12-adaptive", ecc, -13.75, &steps_l);
+    const auto plain = floor_rms<double, KeplerForce>("M12-adaptive", ecc, -13.75, &steps_p);
+    const auto comp = floor_rms<double, CompensatedKeplerForce>("M12-adaptive", ecc, -13.75, &steps_c);
+    const auto ld = floor_rms<long double, KeplerForce>("M12-adaptive", ecc, -13.75, &steps_l);
     std::cout << "M12-adaptive e = " << ecc << ": rms position / velocity error, plain force " << plain.position
               << " / " << plain.velocity << " (" << steps_p << " steps), compensated force " << comp.position << " / "
               << comp.velocity << " (" << steps_c << "), long double " << ld.position << " / " << ld.velocity << " ("
@@ -459,6 +438,11 @@ TEST(Compensated, AdaptiveMpeTakesTheCompensatedForceWhereItCan) {
   opt.rtol = 1e-12;
   EXPECT_FALSE(make_adaptive_mpe_integrator<V>(def, KeplerForce{}, opt).carried());
   EXPECT_FALSE(make_adaptive_mpe_integrator<V>(def, CompensatedKeplerForce{}, opt, off).carried());
+  // Its products carry their rounding at every tolerance (precise_products), the plain force's only at the tightest.
+  opt.rtol = 1e-8;
+  EXPECT_TRUE(make_adaptive_mpe_integrator<V>(def, CompensatedKeplerForce{}, opt).precise_products());
+  EXPECT_FALSE(make_adaptive_mpe_integrator<V>(def, KeplerForce{}, opt).precise_products());
+  EXPECT_FALSE(make_adaptive_mpe_integrator<V>(def, CompensatedKeplerForce{}, opt, off).precise_products());
   try {
     make_adaptive_mpe_integrator<V>(resolve_method("MPE-adaptive"), CompensatedKeplerForce{}, opt);
     ADD_FAILURE() << "order control took a compensated force";

@@ -270,7 +270,7 @@ TEST(AdaptiveFloorCli, Dp12AdaptiveWithTheCompensatedForce) {
 // falling with the tolerance below the plain force's floor, and at the four tightest tolerances it stays at most
 // 1.5e-13 / 1.6e-12 (M12-adaptive, e = 0.5 / 0.9; measured 6.5e-14 and 8.1e-13) and 1e-13 / 2e-12 (M16-adaptive;
 // measured 4.5e-14 and 1.1e-12), a fifth of the plain force's floor or less; every step, accepted or rejected,
-// costs the method's forces.
+// costs the method's forces; the JSON's precise_products is true at every tolerance.
 TEST(AdaptiveFloorCli, AdaptiveMpeWithTheCompensatedForce) {
   for (const std::string method : {"M12-adaptive", "M16-adaptive"}) {
     const AdaptiveInfo info = adaptive_info(method);
@@ -284,8 +284,10 @@ TEST(AdaptiveFloorCli, AdaptiveMpeWithTheCompensatedForce) {
       double worst_plain = 0, worst = 0;
       for (std::size_t i = plain.size() - 4; i < plain.size(); ++i) worst_plain = std::max(worst_plain, plain[i].error);
       for (std::size_t i = comp.size() - 4; i < comp.size(); ++i) worst = std::max(worst, comp[i].error);
-      for (const auto& p : comp)
+      for (const auto& p : comp) {
         EXPECT_EQ(p.force_evals, info.per_step * (p.steps + p.rejected) + 2) << "tol " << p.tol;
+        EXPECT_TRUE(p.precise_products) << "tol " << p.tol;
+      }
       // Below the plain force's tightest tolerance the error still falls: over the last two decades, 10x at least.
       EXPECT_LT(comp.back().error, 0.1 * comp[comp.size() - 9].error);
       std::printf(
@@ -304,8 +306,9 @@ TEST(AdaptiveFloorCli, CompensatedForceIsRefusedWhereNothingUsesIt) {
   for (const std::string args :
        {"--method DP12 --steps-per-period 100", "--method DP12-adaptive --tol 1e-12 --precision long-double",
         "--problem harmonic --method DP12-adaptive --tol 1e-12", "--method DP12-adaptive --tol 1e-12 --force exact",
-        "--method MPE-adaptive --tol 1e-12", "--problem outer-solar-system --method SS10",
-        "--problem arenstorf --method GBS --tol 1e-10", "--problem nbody --n 8 --method DP12 --steps 10"}) {
+        "--method MPE-adaptive --tol 1e-12", "--method MPE-adaptive-max:8 --tol 1e-12",
+        "--problem outer-solar-system --method SS10", "--problem arenstorf --method GBS --tol 1e-10",
+        "--problem nbody --n 8 --method DP12 --steps 10"}) {
     const std::string force = args.find("--force") == std::string::npos ? " --force compensated" : "";
     const auto r = run("run " + args + force + " --json");
     EXPECT_EQ(r.code, 2) << args << ": " << r.err;

@@ -82,11 +82,17 @@ inline constexpr bool takes_velocity_v =
 /// Whether a force is also compensated, force(q, cq, a, alo) besides force(q, a): it takes the position q + cq (cq
 /// the carry of compensated summation) and returns the acceleration a + alo to about twice the working precision.
 /// The compensated runs of the adaptive RKN pairs (engines/rkn.hpp) and of the fixed-step splitting and multi-product
-/// engines (engines/splitting.hpp, engines/mpe.hpp) use it in double and float; the other engines call force(q, a),
+/// engines (engines/splitting.hpp, engines/mpe.hpp) and of the adaptive multi-product expansion of one order
+/// (engines/adaptive_mpe_kernels.hpp) use it in double and float; the other engines call force(q, a),
 /// and solve() runs such a force on the inline path (solve.hpp).
 template <class F, class V>
 inline constexpr bool takes_carry_v =
     std::conjunction_v<std::is_invocable<F&, const V&, const V&, V&, V&>, std::is_invocable<F&, const V&, V&>>;
+
+/// The scalar types whose rounding the engines carry in double-word arithmetic (core/eft.hpp): double and float. The
+/// wider types (long double, dd, qd, float128, MPFR) run without it.
+template <class T>
+inline constexpr bool word_scalar = std::is_same_v<T, double> || std::is_same_v<T, float>;
 
 /// Whether two states hold the same values, element by element (a NaN is never the same): the engines' test that
 /// a cached force or carry still belongs to the state they are given.

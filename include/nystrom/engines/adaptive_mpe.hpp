@@ -115,8 +115,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
     carried_ = Kernels::carried_force && compensated_;
     // With a compensated force the tolerance may go down to eps / 2, as for the adaptive RKN pairs (the refusal
     // says so where such a force would be taken: one order per run, double or float, compensated).
-    const bool could = (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>)&&compensated_ &&
-                       !carried_ && orders.c.empty();
+    const bool could = word_scalar<scalar_type> && compensated_ && !carried_ && orders.c.empty();
     adaptive_detail::check_tolerance<real_type>(opt_, carried_, could);
     if (eopt_.mpe_schedule == MpeSchedule::concurrent)
       throw std::invalid_argument(
@@ -152,11 +151,12 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
   /// Whether the products take the force's rounding: a compensated run in double or float with a compensated force,
   /// force(q, cq, a, alo) (trial_carried, engines/adaptive_mpe_kernels.hpp), at every tolerance.
   bool carried() const { return carried_; }
-  /// Whether the products carry their own rounding (precise products, engines/adaptive_mpe_kernels.hpp): a
-  /// compensated run of a built-in floating type on a symmetric base whose controlled tolerance (tol, or atol when
-  /// tol is 0, through the method's calibration) is at most kPreciseProducts eps, where the increments' rounding,
-  /// not truncation, sets the error.
+  /// Whether the products carry their own rounding (precise products, engines/adaptive_mpe_kernels.hpp): every run
+  /// with a compensated force (carried()); else a compensated run of a built-in floating type on a symmetric base
+  /// whose controlled tolerance (tol, or atol when tol is 0, through the method's calibration) is at most
+  /// kPreciseProducts eps, where the increments' rounding, not truncation, sets the error.
   bool precise_products() const {
+    if (carried_) return true;
     if (!Kernels::can_be_precise || !compensated_ || !merged_) return false;
     const double tol = opt_.rtol > 0 ? opt_.rtol : opt_.atol;
     const double tc = adaptive_detail::controlled_tolerance(tol, opt_.tolerance_exponent, opt_.tolerance_anchor);
@@ -357,6 +357,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
     std::conditional_t<local, State<V>, State<V>&> s = s_io;
     State<V> inc = s_io, err = s_io, low = s_io;  // low: the low part of inc (precise products)
     const bool precise = Comp && precise_products();
+    const bool carried = Comp && carried_;  // the products with a compensated force (trial_carried)
     if (!local) resize_buffers(s_io);
     if (Comp) comp_.begin(s_io);
     std::conditional_t<local, V, V&> ccq = comp_.cq, ccv = comp_.cv;
@@ -386,13 +387,8 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
         store();
         adaptive_detail::throw_underflow("adaptive MPE", as_double(t), as_double(h), error_finite);
       }
-      bool carried = false;  // the products with a compensated force (trial_carried)
-      if constexpr (Comp && Kernels::carried_force) {
-        if (carried_) {
-          a0_evals += this->trial_carried(s, ccq, ccv, h, inc, err, low);
-          carried = true;
-        }
-      }
+      if constexpr (Comp && Kernels::carried_force)
+        if (carried) a0_evals += this->trial_carried(s, ccq, ccv, h, inc, err, low);
       if (!carried && !(local && verlet)) scale(h);
       if (!carried && kick_first_ && !a0_valid) {
         base_.force()(s.q, a0);
@@ -415,7 +411,7 @@ class AdaptiveMpeIntegrator : private adaptive_detail::MpeKernels<V, Force> {
       const double e2 = adaptive_detail::error_norm2(s, inc, err, err_scale, noise_floor_);
       error_finite = e2 < std::numeric_limits<double>::infinity();
       if (e2 <= 1.0) {
-        apply_increment<Comp>(s, ccq, ccv, inc, low, precise || carried);
+        apply_increment<Comp>(s, ccq, ccv, inc, low, precise);
         a0_valid = false;
         t = last ? t1 : t + h;
         ++accepted;

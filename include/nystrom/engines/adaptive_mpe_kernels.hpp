@@ -644,16 +644,15 @@ class MpeKernels {
     base_.scale_products_carried(S(h), k_, carried_);
     cx_.resize(P);
     clo_.resize(P);
-    V a0{}, a0lo{}, a{}, alo{};
-    resize_like(a0, s.q);
-    resize_like(a0lo, s.q);
+    resize_like(ca0_, s.q);
+    resize_like(ca0lo_, s.q);
     long at_s = 0;
     if (kick_first_) {
-      base_.force()(s.q, ccq, a0, a0lo);
+      base_.force()(s.q, ccq, ca0_, ca0lo_);
       ++at_s;
     }
     for (std::size_t i = 0; i < P; ++i)
-      base_.carried_product(s, ccq, ccv, a0, a0lo, carried_.data() + i * m_, k_[i], cx_[i], clo_[i], a, alo);
+      base_.carried_product(s, ccq, ccv, ca0_, ca0lo_, carried_.data() + i * m_, k_[i], cx_[i], clo_[i], ca_, calo_);
     const State<V>& xr = cx_[ref_];
     const State<V>& lr = clo_[ref_];
     for (std::size_t j = 0; j < n; ++j) {
@@ -691,9 +690,11 @@ class MpeKernels {
   std::vector<std::size_t> by_k_;              // product indices by decreasing k (trial_verlet's issue order)
   std::vector<std::vector<scalar_type>> occ_;  // order control: the coefficients of T_2n over k = 1..n
   std::vector<std::vector<scalar_type>> ocd_;  // order control: T_2n - T_{2n-2} over k = 1..n
-  // trial_carried: the double-word coefficients of the products, their states and their carries
+  // trial_carried: the double-word coefficients of the products, their states and their carries, the force at the
+  // step's start (high and low parts) and the products' force buffers
   std::vector<typename SplittingStepper<V, Force>::Scaled> carried_;
   std::vector<State<V>> cx_, clo_;
+  V ca0_{}, ca0lo_{}, ca_{}, calo_{};
 };
 
 }  // namespace adaptive_detail

@@ -294,8 +294,7 @@ class MpeStepper {
   // Other scalars (long double, complex, float128, dd, qd, MPFR) run the same lockstep order through
   // advance_lockstep with a run-time product count, bitwise the same (tests/engines/test_mpe_schedule.cpp),
   // without 16 more instantiations of the engine per state type and force (compile time).
-  static constexpr bool fixed_lockstep =
-      is_std_array<V>::value && (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>);
+  static constexpr bool fixed_lockstep = is_std_array<V>::value && word_scalar<scalar_type>;
 
   // Calls fixed_steps<Comp, K> for K = the number of products; false if there are more than 8.
   template <bool Comp>

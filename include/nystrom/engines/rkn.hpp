@@ -45,8 +45,7 @@ class RknStepper {
   /// Whether the force takes the velocity (force(q, v, a)).
   static constexpr bool velocity_dependent = takes_velocity_v<Force, V>;
   /// Whether a compensated step with an error estimate is made in double-word arithmetic (precise_update).
-  static constexpr bool precise_capable =
-      (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>)&&!velocity_dependent;
+  static constexpr bool precise_capable = word_scalar<scalar_type> && !velocity_dependent;
   /// Whether the precise update also takes the force's rounding error: a compensated force, force(q, cq, a, alo)
   /// (takes_carry_v), evaluated at the stage positions with their low parts.
   static constexpr bool carried_force = precise_capable && takes_carry_v<Force, V>;

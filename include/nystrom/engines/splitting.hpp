@@ -94,8 +94,7 @@ class SplittingStepper {
   /// Whether a compensated run also takes the force's rounding error: with a compensated force, force(q, cq, a, alo)
   /// (takes_carry_v, core/state.hpp), evaluated at q + cq, the drifts and kicks add the exact products of the
   /// coefficients (with their residuals, set_coefficient_residuals) and v + cv or a + alo in double-word arithmetic.
-  static constexpr bool carried_force =
-      (std::is_same_v<scalar_type, double> || std::is_same_v<scalar_type, float>)&&takes_carry_v<Force, V>;
+  static constexpr bool carried_force = word_scalar<scalar_type> && takes_carry_v<Force, V>;
 
   SplittingStepper(SplittingScheme<scalar_type> scheme, Force force, EngineOptions opt = {})
       : scheme_(normalized(scheme)), force_(std::move(force)), opt_(opt) {

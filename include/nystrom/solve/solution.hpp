@@ -51,7 +51,8 @@ struct Solution {
   long accepted = 0, rejected = 0;
   /// Adaptive multi-product methods: whether the products carried their own rounding (precise products: a run in
   /// float or double whose controlled tolerance is at most 1e4 eps, e.g. M12-adaptive at tolerances of 9e-12 and
-  /// below; AdaptiveMpeIntegrator::precise_products). False for every other method.
+  /// below, or at every tolerance with a compensated force; AdaptiveMpeIntegrator::precise_products). False for every
+  /// other method.
   bool precise_products = false;
   SolveStatus status = SolveStatus::success;
   std::string message;
