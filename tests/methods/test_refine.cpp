@@ -62,7 +62,7 @@ int reversal_symmetry(const SplittingScheme<bigcomplex>& s) {
 TEST(Refine, CatalogHasDecimalMethods) {
   std::vector<std::string> names;
   for (const auto& d : decimal_splittings()) names.push_back(d.info.name);
-  // The methods the issue names: Yoshida 6, Kahan-Li, Sofroniou-Spaletta, Blanes-Moan, Gürkan.
+  // The decimal tables: Yoshida 6, Kahan-Li, Sofroniou-Spaletta, Blanes-Moan, Gürkan.
   for (const std::string n : {"Y6", "KL6", "KL8", "SS10", "RKNb6", "RKNa14", "AR1", "AC1", "BC1"})
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
 }
