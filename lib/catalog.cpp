@@ -71,7 +71,6 @@ void finalize_info(MethodDef& d) {
     in.forces_per_step = static_cast<int>(sum) * m->base.forces_per_step() + (kick_first ? 1 : 0);
     in.fsal = false;
     in.complex = false;
-    in.order_control = in.order_control || m->order_control;
     // The adaptive multi-product expansion's global error grows as tol^(1/gamma), gamma = (p - 1) / (p + 1) (the
     // estimate's order over one more than the method's): measured within 0.03 for p = 6..16, tol^1.59 for p = 4
     // (Kepler e = 0.5 and 0.9, outer solar system; engines/step_control.hpp, controlled_tolerance). The anchor:
